@@ -1,0 +1,3 @@
+//! # host-sim
+//!
+//! The desktop simulator.

@@ -1,0 +1,28 @@
+//! # gesture-runtime
+//!
+//! The part of the gesture controller that runs on the board: microphone samples in, a belief
+//! over gesture-style states per syllable, a gesture choice at each segment exit, and poses and
+//! servo duty cycles out (Levine et al., *Gesture Controllers*, SIGGRAPH 2010; the design is
+//! restated in `DESIGN.md`).
+//!
+//! ## Contract
+//!
+//! - `#![no_std]`, no `alloc`: every buffer has a compile-time capacity and every state type has
+//!   a size known at compile time.
+//! - No panics on any input: arbitrary samples (silence, clipping, DC) and, once loaded, arbitrary
+//!   blob bytes give correct output or a typed error. Outputs are always finite.
+//! - Deterministic: `f32` arithmetic with `libm`, so the same input gives the same decisions on
+//!   the host and on a Cortex-M4F, and no result depends on how the input is chunked.
+//! - The trainer computes its features by calling this crate, so training and device features
+//!   cannot drift apart.
+//!
+//! ## Modules
+//!
+//! - [`prosody`]: the streaming front-end: per 10 ms frame F0 (Praat-style autocorrelation with
+//!   a fixed-lag path finder) and intensity (Praat's window); syllables from intensity troughs
+//!   and pause steps during silence.
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod prosody;

@@ -1,0 +1,415 @@
+//! The streaming prosody front-end: PCM samples in; per 10 ms frame F0 and intensity; per
+//! syllable (or pause) one [`Step`] with its features.
+//!
+//! ```text
+//!  i16 samples ─┬─► 1 ms block sums ──────────────► intensity (dB, Praat's Kaiser window)
+//!               └─► half-band ÷2 ─► 40 ms Hann ─► autocorrelation ─► candidates
+//!                                                     ─► fixed-lag path finder ─► F0
+//!  per frame (F0, dB) ─► SyllableDetector ─► Step { syllable | pause }
+//! ```
+//!
+//! **Timing.** Frame `k` (k = 1, 2, ...) is centred at `k * 10 ms` after the first sample; the
+//! signal is taken as silent before its start. A frame is final once the pitch path finder has
+//! seen [`viterbi::LAG`] more frames, i.e. about `20 + 10 * LAG` ms after its centre (70 ms);
+//! a syllable is reported when the rise after its closing trough confirms it.
+//!
+//! **Determinism.** Samples are processed one at a time into fixed rings; a frame is computed
+//! when its last sample arrives. The chunking of the input therefore cannot change any result:
+//! pushing 1, 7, 160 or 4096 samples at a time gives bit-identical frames and steps (tested).
+//! All arithmetic is `f32` with `libm`, so host and Cortex-M4F agree bit for bit.
+//!
+//! **Safety.** No allocation, no recursion, no panics for any input; every output is finite
+//! (intensity of exact silence is Praat's `-300 dB`). The state has a compile-time size
+//! (about 9 KiB) and analysing a frame uses about 5 KiB of stack.
+//!
+//! Sample rates: 8 to 16 kHz in whole kHz (the pitch path runs at half the rate above 8 kHz).
+//! Hosts resample other rates before feeding the front-end.
+
+pub mod decimate;
+pub mod intensity;
+pub mod pitch;
+pub mod syllable;
+pub mod viterbi;
+
+pub use pitch::PitchParams;
+pub use syllable::{Step, StepKind, SyllableParams};
+
+use decimate::HalfBand;
+use intensity::Intensity;
+use pitch::{Candidates, GlobalPeak, PitchAnalyzer, MAX_WINDOW};
+use syllable::SyllableDetector;
+use viterbi::PathFinder;
+
+/// Frame hop in seconds.
+pub const HOP_S: f64 = 0.01;
+/// Lowest supported front-end rate (Hz).
+pub const MIN_RATE_HZ: u32 = 8_000;
+/// Highest supported front-end rate (Hz).
+pub const MAX_RATE_HZ: u32 = 16_000;
+/// Default front-end rate (Hz).
+pub const DEFAULT_RATE_HZ: u32 = 16_000;
+
+/// Ring of decimated samples (power of two, holds a window plus slack).
+const PITCH_RING: usize = 512;
+const _: () = assert!(PITCH_RING >= MAX_WINDOW + 64 && PITCH_RING.is_power_of_two());
+
+/// Front-end settings; stored in the policy blob so training and device use the same ones.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProsodyConfig {
+    /// Sample rate of the PCM fed to the front-end (Hz).
+    pub sample_rate_hz: u32,
+    /// Pitch estimator settings.
+    pub pitch: PitchParams,
+    /// Syllable detector settings.
+    pub syllables: SyllableParams,
+}
+
+impl ProsodyConfig {
+    /// 16 kHz, Praat's pitch defaults (75-600 Hz), default syllable detector.
+    pub const DEFAULT: Self = Self {
+        sample_rate_hz: DEFAULT_RATE_HZ,
+        pitch: PitchParams::PRAAT,
+        syllables: SyllableParams::DEFAULT,
+    };
+}
+
+impl Default for ProsodyConfig {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
+
+/// Why a [`ProsodyConfig`] was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfigError {
+    /// The rate is outside 8-16 kHz or not a whole number of kHz.
+    UnsupportedSampleRate(u32),
+    /// The pitch range does not fit the analysis capacities (floor must be >= 75 Hz, the
+    /// ceiling above twice the floor and below a quarter of the pitch analysis rate).
+    PitchRange,
+    /// A pitch cost or threshold is negative or not finite.
+    PitchParams,
+    /// A syllable parameter is out of range (margin and range must be positive and finite,
+    /// frame counts at least 1).
+    SyllableParams,
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::UnsupportedSampleRate(r) => write!(
+                f,
+                "unsupported front-end sample rate {r} Hz (use 8000-16000 in whole kHz)"
+            ),
+            Self::PitchRange => f.write_str(
+                "pitch range does not fit the analysis window (floor >= 75 Hz, ceiling > 2x floor)",
+            ),
+            Self::PitchParams => f.write_str("pitch thresholds and costs must be finite and >= 0"),
+            Self::SyllableParams => f.write_str(
+                "syllable parameters out of range (margin, range > 0; min and pause frames >= 1)",
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
+/// One analysis frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// Frame number, from 1; centred at `index * 10 ms`.
+    pub index: u32,
+    /// F0 in Hz, `None` when unvoiced.
+    pub f0_hz: Option<f32>,
+    /// Intensity in dB re 2e-5 with full scale = 1 (Praat's convention; -300 for exact silence).
+    pub intensity_db: f32,
+}
+
+impl Frame {
+    /// Centre time in seconds.
+    pub fn time_s(&self) -> f64 {
+        self.index as f64 * HOP_S
+    }
+}
+
+/// What the front-end reports, in time order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event {
+    /// A finished frame.
+    Frame(Frame),
+    /// A finished syllable or pause step (reported after the frame that completed it).
+    Step(Step),
+}
+
+fn finite_nonneg(v: f32) -> bool {
+    v.is_finite() && v >= 0.0
+}
+
+/// The streaming front-end. See the module docs for timing and invariants.
+#[derive(Clone, Debug)]
+pub struct FrontEnd {
+    config: ProsodyConfig,
+    /// Input samples per frame hop.
+    hop: u32,
+    /// Decimated samples per frame hop.
+    pitch_hop: u32,
+    decimator: Option<HalfBand>,
+    /// Output delay of the decimator in decimated samples.
+    delay: u64,
+    ring: [f32; PITCH_RING],
+    /// Decimated samples produced so far (including the decimator's delay).
+    produced: u64,
+    analyzer: PitchAnalyzer,
+    global: GlobalPeak,
+    path: PathFinder,
+    intensity: Intensity,
+    syllables: SyllableDetector,
+    /// Next frame to analyse for pitch.
+    next_pitch: u32,
+    /// Last frame to analyse (set at end of stream).
+    limit: u32,
+    /// Frames already reported.
+    emitted: u32,
+    /// Samples pushed since the start of the stream.
+    samples: u64,
+}
+
+impl FrontEnd {
+    /// A front-end for `config`, or why the config is refused.
+    pub fn new(config: &ProsodyConfig) -> Result<Self, ConfigError> {
+        let rate = config.sample_rate_hz;
+        if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) || rate % 1000 != 0 {
+            return Err(ConfigError::UnsupportedSampleRate(rate));
+        }
+        let p = &config.pitch;
+        let all_ok = [
+            p.silence_threshold,
+            p.voicing_threshold,
+            p.octave_cost,
+            p.octave_jump_cost,
+            p.voiced_unvoiced_cost,
+        ]
+        .iter()
+        .all(|&v| finite_nonneg(v));
+        if !all_ok {
+            return Err(ConfigError::PitchParams);
+        }
+        let decimate = rate > MIN_RATE_HZ;
+        let pitch_rate = if decimate { rate / 2 } else { rate };
+        if !(p.floor_hz.is_finite() && p.ceiling_hz.is_finite())
+            || p.floor_hz < 75.0
+            || p.ceiling_hz <= 2.0 * p.floor_hz
+            || p.ceiling_hz * 4.0 > pitch_rate as f32
+        {
+            return Err(ConfigError::PitchRange);
+        }
+        let analyzer = PitchAnalyzer::new(pitch_rate, *p).ok_or(ConfigError::PitchRange)?;
+        let intensity = Intensity::new(rate, p.floor_hz).ok_or(ConfigError::PitchRange)?;
+        let s = &config.syllables;
+        if !(s.margin_db.is_finite() && s.margin_db > 0.0)
+            || !(s.range_db.is_finite() && s.range_db > 0.0)
+            || !s.floor_db.is_finite()
+            || !s.initial_peak_db.is_finite()
+            || s.min_frames == 0
+            || s.pause_frames == 0
+        {
+            return Err(ConfigError::SyllableParams);
+        }
+        Ok(Self {
+            config: *config,
+            hop: rate / 100,
+            pitch_hop: pitch_rate / 100,
+            decimator: if decimate {
+                Some(HalfBand::new())
+            } else {
+                None
+            },
+            delay: if decimate { HalfBand::DELAY as u64 } else { 0 },
+            ring: [0.0; PITCH_RING],
+            produced: 0,
+            analyzer,
+            global: GlobalPeak::new(),
+            path: PathFinder::new(p),
+            intensity,
+            syllables: SyllableDetector::new(*s),
+            next_pitch: 1,
+            limit: u32::MAX,
+            emitted: 0,
+            samples: 0,
+        })
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &ProsodyConfig {
+        &self.config
+    }
+
+    /// Forgets all input: the next sample starts a new stream at time 0.
+    pub fn reset(&mut self) {
+        self.decimator = self.decimator.as_ref().map(|_| HalfBand::new());
+        self.ring = [0.0; PITCH_RING];
+        self.produced = 0;
+        self.global = GlobalPeak::new();
+        self.path.reset();
+        self.intensity.reset();
+        self.syllables.reset();
+        self.next_pitch = 1;
+        self.limit = u32::MAX;
+        self.emitted = 0;
+        self.samples = 0;
+    }
+
+    /// Feeds samples (any count); reports finished frames and steps through `sink`, in order.
+    pub fn push(&mut self, samples: &[i16], sink: &mut impl FnMut(Event)) {
+        for &s in samples {
+            self.push_one(s, sink);
+        }
+        self.samples += samples.len() as u64;
+    }
+
+    #[inline]
+    fn push_one(&mut self, s: i16, sink: &mut impl FnMut(Event)) {
+        self.intensity.push(s);
+        let x = s as f32 * (1.0 / 32768.0);
+        let y = match &mut self.decimator {
+            Some(d) => match d.push(x) {
+                Some(y) => y,
+                None => return,
+            },
+            None => x,
+        };
+        self.ring[(self.produced % PITCH_RING as u64) as usize] = y;
+        self.produced += 1;
+        // Decimated time index of the newest sample is produced - 1 - delay.
+        let half = (self.analyzer.window_len() / 2) as u64;
+        let needed = self.next_pitch as u64 * self.pitch_hop as u64 + half + self.delay;
+        if self.produced >= needed && self.next_pitch <= self.limit {
+            self.analyse_frame(sink);
+        }
+    }
+
+    /// Analyses pitch frame `next_pitch` (its window is complete) and reports what became final.
+    fn analyse_frame(&mut self, sink: &mut impl FnMut(Event)) {
+        let k = self.next_pitch as u64;
+        let half = (self.analyzer.window_len() / 2) as u64;
+        let len = self.analyzer.window_len();
+        // Window covers decimated time indices [k*hop - half, k*hop + half), stored at
+        // ring position (time index + delay).
+        // Indices before the stream's start wrap to ring slots that still hold zeros.
+        let first = (k * self.pitch_hop as u64 + self.delay) as i64 - half as i64;
+        let mut win = [0.0f32; MAX_WINDOW];
+        for (i, w) in win.iter_mut().take(len).enumerate() {
+            *w = self.ring[(first + i as i64).rem_euclid(PITCH_RING as i64) as usize];
+        }
+        let mut cand = Candidates::UNVOICED;
+        self.analyzer
+            .analyze(&win[..len], &mut self.global, &mut cand);
+        self.next_pitch += 1;
+        if let Some(d) = self.path.push(&cand) {
+            self.emit(d.f0_hz, sink);
+        }
+    }
+
+    /// Reports the next frame with its decided F0.
+    fn emit(&mut self, f0: f32, sink: &mut impl FnMut(Event)) {
+        let index = self.emitted + 1;
+        self.emitted = index;
+        let db = self
+            .intensity
+            .frame_db(index as u64 * 10)
+            .unwrap_or(intensity::SILENT_DB);
+        let f0_hz = if f0 > 0.0 { Some(f0) } else { None };
+        sink(Event::Frame(Frame {
+            index,
+            f0_hz,
+            intensity_db: db,
+        }));
+        if let Some(step) = self.syllables.push(index, f0_hz, db) {
+            sink(Event::Step(step));
+        }
+    }
+
+    /// Ends the stream: reports every frame centred within the input, closes an open syllable,
+    /// and resets the front-end for a new stream.
+    pub fn finish(&mut self, sink: &mut impl FnMut(Event)) {
+        let last = (self.samples / self.hop as u64).min(u32::MAX as u64 - 1) as u32;
+        self.limit = last;
+        let need_blocks = last as u64 * 10 + self.intensity.half_blocks() as u64;
+        // Append silence until the last frame's pitch window and intensity window are complete.
+        let mut guard = 0u32;
+        while (self.next_pitch <= last || self.intensity.blocks() < need_blocks) && guard < 100_000
+        {
+            self.push_one(0, sink);
+            guard += 1;
+        }
+        let mut decided = [0.0f32; viterbi::LAG + 1];
+        let mut n = 0usize;
+        self.path.flush(|d| {
+            if n < decided.len() {
+                decided[n] = d.f0_hz;
+                n += 1;
+            }
+        });
+        for &f0 in &decided[..n] {
+            if self.emitted < last {
+                self.emit(f0, sink);
+            }
+        }
+        if let Some(step) = self.syllables.flush(self.emitted + 1) {
+            sink(Event::Step(step));
+        }
+        self.reset();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_configs() {
+        let mut c = ProsodyConfig::DEFAULT;
+        c.sample_rate_hz = 44_100;
+        assert_eq!(
+            FrontEnd::new(&c).err(),
+            Some(ConfigError::UnsupportedSampleRate(44_100))
+        );
+        let mut c = ProsodyConfig::DEFAULT;
+        c.pitch.floor_hz = 50.0;
+        assert_eq!(FrontEnd::new(&c).err(), Some(ConfigError::PitchRange));
+        let mut c = ProsodyConfig::DEFAULT;
+        c.pitch.voicing_threshold = f32::NAN;
+        assert_eq!(FrontEnd::new(&c).err(), Some(ConfigError::PitchParams));
+        let mut c = ProsodyConfig::DEFAULT;
+        c.syllables.pause_frames = 0;
+        assert_eq!(FrontEnd::new(&c).err(), Some(ConfigError::SyllableParams));
+        for rate in [8000, 12000, 16000] {
+            let mut c = ProsodyConfig::DEFAULT;
+            c.sample_rate_hz = rate;
+            assert!(FrontEnd::new(&c).is_ok(), "{rate}");
+        }
+    }
+
+    #[test]
+    fn frame_count_covers_input() {
+        let mut fe = FrontEnd::new(&ProsodyConfig::DEFAULT).unwrap();
+        let samples = [0i16; 16_000 + 50];
+        let mut frames = 0u32;
+        let mut last = 0;
+        fe.push(&samples, &mut |e| {
+            if let Event::Frame(f) = e {
+                frames += 1;
+                assert_eq!(f.index, last + 1);
+                last = f.index;
+            }
+        });
+        fe.finish(&mut |e| {
+            if let Event::Frame(f) = e {
+                frames += 1;
+                assert_eq!(f.index, last + 1);
+                last = f.index;
+            }
+        });
+        assert_eq!(frames, 100);
+    }
+}

@@ -1,0 +1,3 @@
+//! # gesture-trainer
+//!
+//! Host-side learning for the gesture controller.
