@@ -42,7 +42,7 @@ impl SyllableParams {
         range_db: 25.0,
         floor_db: 25.0,
         initial_peak_db: 70.0,
-        min_frames: 4,
+        min_frames: 6,
         pause_frames: 25,
     };
 }
