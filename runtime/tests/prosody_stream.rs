@@ -98,7 +98,10 @@ fn median(mut v: Vec<f32>) -> f32 {
 fn chunking_does_not_change_any_result() {
     let x = speechlike(4.0, 7);
     let whole = run_chunked(&x, x.len());
-    assert!(steps(&whole).len() > 5, "the input should contain syllables");
+    assert!(
+        steps(&whole).len() > 5,
+        "the input should contain syllables"
+    );
     assert_eq!(frames(&whole).len(), 400);
     for chunk in [1usize, 7, 160, 4096] {
         let got = run_chunked(&x, chunk);
@@ -139,7 +142,9 @@ fn silence_is_unvoiced_at_praat_floor_with_pause_steps() {
     let ev = run_chunked(&x, 512);
     let fr = frames(&ev);
     assert_eq!(fr.len(), 200);
-    assert!(fr.iter().all(|f| f.f0_hz.is_none() && f.intensity_db == -300.0));
+    assert!(fr
+        .iter()
+        .all(|f| f.f0_hz.is_none() && f.intensity_db == -300.0));
     let st = steps(&ev);
     assert!(st.iter().all(|s| s.kind == StepKind::Pause));
     // One pause step per 250 ms of silence.
@@ -173,7 +178,11 @@ fn pure_tones_have_their_pitch() {
         let a = 8000.0f32 / 32768.0;
         let want = 10.0 * (a * a / 2.0 / 4.0e-10).log10();
         for fr in &fr {
-            assert!((fr.intensity_db - want).abs() < 0.1, "{f} Hz: {}", fr.intensity_db);
+            assert!(
+                (fr.intensity_db - want).abs() < 0.1,
+                "{f} Hz: {}",
+                fr.intensity_db
+            );
         }
     }
 }
@@ -189,7 +198,11 @@ fn clipping_keeps_the_pitch() {
     assert!((median(voiced) - 150.0).abs() < 1.0);
     for f in &fr {
         // A full-scale square wave is 93.98 dB; the clipped sine is just below.
-        assert!(f.intensity_db > 92.0 && f.intensity_db < 94.0, "{}", f.intensity_db);
+        assert!(
+            f.intensity_db > 92.0 && f.intensity_db < 94.0,
+            "{}",
+            f.intensity_db
+        );
     }
 }
 
@@ -209,10 +222,16 @@ fn dc_offset_changes_nothing() {
 #[test]
 fn noise_is_mostly_unvoiced() {
     let mut rng = Lcg(5);
-    let x: Vec<i16> = (0..32_000).map(|_| (rng.uniform() * 20000.0) as i16).collect();
+    let x: Vec<i16> = (0..32_000)
+        .map(|_| (rng.uniform() * 20000.0) as i16)
+        .collect();
     let fr = frames(&run_chunked(&x, 160));
     let voiced = fr.iter().filter(|f| f.f0_hz.is_some()).count();
-    assert!(voiced * 20 < fr.len(), "{voiced} of {} noise frames voiced", fr.len());
+    assert!(
+        voiced * 20 < fr.len(),
+        "{voiced} of {} noise frames voiced",
+        fr.len()
+    );
 }
 
 #[test]
@@ -223,8 +242,20 @@ fn garbage_never_panics_and_outputs_stay_in_range() {
         let x: Vec<i16> = (0..n)
             .map(|i| match round % 5 {
                 0 => rng.next_u32() as i16,
-                1 => if i % 2 == 0 { i16::MAX } else { i16::MIN },
-                2 => if rng.next_u32() % 500 == 0 { i16::MIN } else { 0 },
+                1 => {
+                    if i % 2 == 0 {
+                        i16::MAX
+                    } else {
+                        i16::MIN
+                    }
+                }
+                2 => {
+                    if rng.next_u32() % 500 == 0 {
+                        i16::MIN
+                    } else {
+                        0
+                    }
+                }
                 3 => i16::MIN,
                 _ => ((i as f32 * 0.001).sin() * 32767.0) as i16,
             })
