@@ -1,3 +1,17 @@
 //! # gesture-trainer
 //!
-//! Host-side learning for the gesture controller.
+//! Host-side learning for the gesture controller (DESIGN.md, "The method"): corpus ingestion,
+//! model fitting and packing of the policy blob. `std`, allocates freely; every parser of outside
+//! bytes returns a typed error instead of panicking.
+//!
+//! ## Modules
+//!
+//! - [`audio`]: WAV files (8-48 kHz, any common PCM/float encoding) to mono `i16` at the
+//!   front-end rate, band-limited resampling with timing and length preserved.
+//! - [`features`]: prosody frames and syllable steps, computed by calling the runtime's
+//!   front-end (never re-implemented here).
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod audio;
+pub mod features;
