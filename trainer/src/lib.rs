@@ -15,3 +15,6 @@
 
 pub mod audio;
 pub mod features;
+pub mod corpus;
+pub mod inference;
+pub mod synth;

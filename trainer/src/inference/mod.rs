@@ -1,0 +1,5 @@
+//! The inference layer (DESIGN.md, "Inference layer"): an HMM over kinematic parameters, a
+//! Gaussian mixture over prosody, and the remapped CRF trained from the HMM's posteriors.
+
+pub mod gaussian;
+pub mod hmm;
