@@ -21,8 +21,11 @@
 //! - [`prosody`]: the streaming front-end: per 10 ms frame F0 (Praat-style autocorrelation with
 //!   a fixed-lag path finder) and intensity (Praat's window); syllables from intensity troughs
 //!   and pause steps during silence.
+//! - [`inference`]: speaker-normalized step features, prosody-cluster memberships and the CRF
+//!   forward step: the belief over hidden gesture-style states.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod inference;
 pub mod prosody;

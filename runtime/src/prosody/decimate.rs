@@ -30,7 +30,7 @@ pub struct HalfBand {
 
 impl HalfBand {
     /// Delay of the output in decimated samples (output `j` is centred on time index `j - DELAY`).
-    pub const DELAY: usize = (CENTRE + 1) / 2 - 1;
+    pub const DELAY: usize = CENTRE.div_ceil(2) - 1;
 
     /// A decimator with zero history (the signal is taken as silent before its start).
     pub fn new() -> Self {

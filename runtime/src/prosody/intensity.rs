@@ -209,7 +209,7 @@ impl Intensity {
         let sw = self.weight_sum;
         let power = (s2w - 2.0 * m * s1w + m * m * sw) / sw;
         let p = power * self.scale;
-        if !(p > 1.0e-30) || !p.is_finite() {
+        if p.is_nan() || p <= 1.0e-30 || !p.is_finite() {
             return Some(SILENT_DB);
         }
         Some(10.0 * libm::log10f(p))

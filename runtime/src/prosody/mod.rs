@@ -206,8 +206,9 @@ impl FrontEnd {
         let analyzer = PitchAnalyzer::new(pitch_rate, *p).ok_or(ConfigError::PitchRange)?;
         let intensity = Intensity::new(rate, p.floor_hz).ok_or(ConfigError::PitchRange)?;
         let s = &config.syllables;
-        if !(s.margin_db.is_finite() && s.margin_db > 0.0)
-            || !(s.range_db.is_finite() && s.range_db > 0.0)
+        let positive = |v: f32| v.is_finite() && v > 0.0;
+        if !positive(s.margin_db)
+            || !positive(s.range_db)
             || !s.floor_db.is_finite()
             || !s.initial_peak_db.is_finite()
             || s.min_frames == 0

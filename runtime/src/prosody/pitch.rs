@@ -117,7 +117,7 @@ impl GlobalPeak {
     /// Floor of the tracker, in full-scale units (-60 dBFS).
     pub const FLOOR: f32 = 1.0e-3;
     /// Per-frame decay factor (half-life 3000 frames of 10 ms).
-    const DECAY: f32 = 0.999_769_0;
+    const DECAY: f32 = 0.999_769;
 
     /// A tracker at its floor.
     pub const fn new() -> Self {
@@ -169,7 +169,7 @@ impl PitchAnalyzer {
         let nominal = libm::floorf(3.0 * rate / params.floor_hz) as usize;
         let half = (nominal / 2).checked_sub(1)?;
         let window_len = 2 * half;
-        if window_len > MAX_WINDOW || window_len < 8 {
+        if !(8..=MAX_WINDOW).contains(&window_len) {
             return None;
         }
         let period = libm::floorf(rate / params.floor_hz) as usize;
@@ -277,7 +277,7 @@ impl PitchAnalyzer {
         }
         let mut r = [0.0f32; MAX_LAGS];
         autocorrelation(&mut buf, &mut r);
-        if !(r[0] > 0.0) || !r[0].is_finite() {
+        if r[0].is_nan() || r[0] <= 0.0 || !r[0].is_finite() {
             return;
         }
         let inv0 = 1.0 / r[0];
