@@ -7,9 +7,19 @@
 //!
 //! ## Modules
 //!
+//! - [`cli`]: the `gesture-sim` command line, exit codes and error lines.
+//! - [`prosody_cmd`]: `gesture-sim prosody`: per-frame or per-syllable CSV of a WAV file.
 //! - [`eval`]: pure comparison functions (reference CSV parsing, frame matching, the metrics
 //!   of `shared/tools/prosody_compare.py`, syllable counts).
+//! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
+//! - [`bench`]: `gesture-sim bench-prosody`: front-end speed.
+//! - [`synth_audio`]: deterministic speech-like test audio.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod bench;
+pub mod cli;
 pub mod eval;
+pub mod eval_cmd;
+pub mod prosody_cmd;
+pub mod synth_audio;
