@@ -363,7 +363,10 @@ fn decode_mono(bytes: &[u8], path: &Path) -> Result<(Vec<f32>, SourceFormat), Au
             read / channels
         ),
     };
-    let mut interleaved = Vec::with_capacity(frames * channels);
+    // The header's promise is capped by what the bytes can hold: a damaged length field must
+    // not turn into a multi-gigabyte allocation.
+    let max_samples = bytes.len() / (spec.bits_per_sample as usize / 8).max(1);
+    let mut interleaved = Vec::with_capacity((frames * channels).min(max_samples));
     match encoding {
         Encoding::Float(_) => {
             for s in reader.into_samples::<f32>() {

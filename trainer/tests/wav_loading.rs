@@ -305,6 +305,11 @@ fn garbage_and_truncated_files() {
             "cut at {cut}: {e:?}"
         );
     }
+    // A damaged length field promising ~2 G frames: an error, not a huge allocation.
+    let mut huge = good.clone();
+    huge[40..44].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+    let p = write_bytes(dir.path(), "huge-length.wav", &huge);
+    assert!(matches!(expect_err(&p), AudioError::Truncated { .. }));
     // Data chunk promises 1600 frames, the file holds 1000.
     let p = write_bytes(dir.path(), "data-cut.wav", &good[..44 + 2000]);
     let e = expect_err(&p);
