@@ -12,7 +12,7 @@
 //! - [`eval`]: pure comparison functions (reference CSV parsing, frame matching, the metrics
 //!   of `shared/tools/prosody_compare.py`, syllable counts).
 //! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
-//! - [`bench`]: `gesture-sim bench-prosody`: front-end speed.
+//! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
 //! - [`synth_audio`]: deterministic speech-like test audio.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

@@ -27,7 +27,7 @@
 //!
 //! Why some of this is hand-written: hound decodes the samples, but its header errors are
 //! static strings that do not say *which* sample format was refused, so on that error path
-//! [`describe_fmt`] re-reads the `fmt ` chunk only to name the format in the message. The whole
+//! `describe_fmt` re-reads the `fmt ` chunk only to name the format in the message. The whole
 //! file is read into memory first (WAV files we handle are at most tens of MB), which also makes
 //! every I/O error after opening mean "the file ends early".
 
