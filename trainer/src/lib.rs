@@ -10,6 +10,8 @@
 //!   front-end rate, band-limited resampling with timing and length preserved.
 //! - [`features`]: prosody frames and syllable steps, computed by calling the runtime's
 //!   front-end (never re-implemented here).
+//! - [`motion`]: BVH reading/writing, forward kinematics, end effectors, segmentation into
+//!   gesture phases and the six kinematic parameters per segment with their normalization.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -17,4 +19,5 @@ pub mod audio;
 pub mod features;
 pub mod corpus;
 pub mod inference;
+pub mod motion;
 pub mod synth;
