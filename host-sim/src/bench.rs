@@ -1,7 +1,7 @@
 //! `gesture-sim bench-prosody`: how fast the front-end runs on this machine (a report, not a
 //! test).
 //!
-//! The audio is [`crate::synth_audio::speech_like`] (seeded, in memory) or a WAV file. Each run
+//! The audio is the synthetic corpus speech of `gesture-train synth` (seeded, in memory) or a WAV file. Each run
 //! creates a fresh front-end, pushes the whole signal in 256-sample chunks (a typical DMA
 //! buffer; results do not depend on chunking) and ends the stream, on one thread, timed with
 //! `std::time::Instant`. Reported: median and minimum wall time, the real-time multiple
@@ -16,7 +16,7 @@ use gesture_runtime::prosody::{Event, FrontEnd, ProsodyConfig};
 use gesture_trainer::audio;
 
 use crate::cli::CliError;
-use crate::synth_audio;
+use gesture_trainer::synth;
 
 /// Seed of the synthetic benchmark signal.
 pub const SEED: u64 = 0x6765_7374_7572_6521;
@@ -109,8 +109,8 @@ pub fn run(
             p.display().to_string(),
         ),
         None => (
-            synth_audio::speech_like(seconds, rate, SEED),
-            format!("synthetic speech-like audio (seed {SEED:#x})"),
+            synth::generate_take(SEED, 0, seconds, &synth::speaker_for(SEED)).audio,
+            format!("synthetic speech (gesture-train synth, seed {SEED})"),
         ),
     };
     let r = measure(&samples, &config, runs, source)?;

@@ -13,7 +13,6 @@
 //!   of `shared/tools/prosody_compare.py`, syllable counts).
 //! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
 //! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
-//! - [`synth_audio`]: deterministic speech-like test audio.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -22,4 +21,3 @@ pub mod cli;
 pub mod eval;
 pub mod eval_cmd;
 pub mod prosody_cmd;
-pub mod synth_audio;

@@ -16,8 +16,9 @@
 #![warn(missing_docs)]
 
 pub mod audio;
-pub mod features;
+pub mod cli;
 pub mod corpus;
+pub mod features;
 pub mod inference;
 pub mod motion;
 pub mod synth;

@@ -198,8 +198,7 @@ mod tests {
     #[test]
     fn errors_name_the_input() {
         let dir = tempfile::tempdir().unwrap();
-        let missing = dir.path().join("nope");
-        let e = discover(&[missing.clone()]).unwrap_err();
+        let e = discover(&[dir.path().join("nope")]).unwrap_err();
         assert!(e.to_string().contains("nope"), "{e}");
         touch(&dir.path().join("x.txt"));
         let e = discover(&[dir.path().join("x.txt")]).unwrap_err();

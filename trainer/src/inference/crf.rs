@@ -111,7 +111,7 @@ impl Crf {
         v
     }
 
-    fn from_vec(&self, v: &[f64]) -> Self {
+    fn with_params(&self, v: &[f64]) -> Self {
         let s = self.states;
         Self {
             states: s,
@@ -285,7 +285,7 @@ impl Crf {
             .get_best_param()
             .cloned()
             .unwrap_or_else(|| start.to_vec());
-        let crf = start.from_vec(&best);
+        let crf = start.with_params(&best);
         let objective = crf.objective_and_gradient(seqs, cfg.l2).0;
         Ok((
             crf,
@@ -310,7 +310,7 @@ impl CostFunction for Problem<'_> {
     type Param = Vec<f64>;
     type Output = f64;
     fn cost(&self, p: &Vec<f64>) -> Result<f64, argmin::core::Error> {
-        let crf = self.template.from_vec(p);
+        let crf = self.template.with_params(p);
         Ok(-crf.objective_and_gradient(self.seqs, self.l2).0 * self.scale)
     }
 }
@@ -319,7 +319,7 @@ impl Gradient for Problem<'_> {
     type Param = Vec<f64>;
     type Gradient = Vec<f64>;
     fn gradient(&self, p: &Vec<f64>) -> Result<Vec<f64>, argmin::core::Error> {
-        let crf = self.template.from_vec(p);
+        let crf = self.template.with_params(p);
         let g = crf.objective_and_gradient(self.seqs, self.l2).1;
         Ok(g.iter().map(|v| -v * self.scale).collect())
     }
@@ -370,7 +370,7 @@ mod tests {
         for v in theta.iter_mut() {
             *v = rng.random_range(-1.0..1.0);
         }
-        crf = crf.from_vec(&theta);
+        crf = crf.with_params(&theta);
         let (_, grad) = crf.objective_and_gradient(&seqs, 0.1);
         let h = 1e-6;
         for i in 0..theta.len() {
@@ -378,8 +378,8 @@ mod tests {
             a[i] += h;
             let mut b = theta.clone();
             b[i] -= h;
-            let fa = crf.from_vec(&a).objective_and_gradient(&seqs, 0.1).0;
-            let fb = crf.from_vec(&b).objective_and_gradient(&seqs, 0.1).0;
+            let fa = crf.with_params(&a).objective_and_gradient(&seqs, 0.1).0;
+            let fb = crf.with_params(&b).objective_and_gradient(&seqs, 0.1).0;
             let fd = (fa - fb) / (2.0 * h);
             assert!(
                 (fd - grad[i]).abs() < 1e-6 * (1.0 + fd.abs()),
@@ -398,7 +398,7 @@ mod tests {
         let theta: Vec<f64> = (0..crf.n_params())
             .map(|_| rng.random_range(-2.0..2.0))
             .collect();
-        crf = crf.from_vec(&theta);
+        crf = crf.with_params(&theta);
         let phi = crf.observation_scores(&q.memberships);
         let mut z = 0.0;
         for code in 0..s.pow(4) {

@@ -1,6 +1,9 @@
 //! The inference layer (DESIGN.md, "Inference layer"): an HMM over kinematic parameters, a
 //! Gaussian mixture over prosody, and the remapped CRF trained from the HMM's posteriors.
 
+// Index loops mirror the equations (alpha[t][i], xi[t][i * S + j]) and are kept on purpose.
+#![allow(clippy::needless_range_loop)]
+
 pub mod crf;
 pub mod gaussian;
 pub mod gmm;

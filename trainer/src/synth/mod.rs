@@ -9,9 +9,13 @@ pub mod gesture;
 pub mod speech;
 pub mod styles;
 
+use std::path::{Path, PathBuf};
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
+
+use crate::motion::{Channel, Joint, Motion, Skeleton};
 
 /// Front-end rate of the synthetic audio (Hz).
 pub const AUDIO_RATE: u32 = 16_000;
@@ -149,6 +153,121 @@ pub fn take_rng(seed: u64, index: usize, stream: u64) -> ChaCha8Rng {
     rng
 }
 
+/// The synthetic skeleton as a BVH skeleton.
+pub fn skeleton() -> Skeleton {
+    use Channel::*;
+    let joints = gesture::SKELETON
+        .iter()
+        .map(|j| Joint {
+            name: j.name.to_string(),
+            parent: j.parent,
+            offset: j.offset,
+            channels: if j.parent.is_none() {
+                vec![
+                    Xposition, Yposition, Zposition, Zrotation, Yrotation, Xrotation,
+                ]
+            } else {
+                vec![Zrotation, Yrotation, Xrotation]
+            },
+            end_site: j.end_site,
+        })
+        .collect();
+    Skeleton { joints }
+}
+
+impl Take {
+    /// The take's motion as a BVH motion.
+    pub fn motion(&self) -> Motion {
+        Motion::new(
+            skeleton(),
+            1.0 / gesture::FPS,
+            self.frames,
+            self.motion.clone(),
+        )
+        .expect("the synthetic skeleton and its channel data are consistent")
+        .with_source(format!("{}.bvh", self.stem))
+    }
+}
+
+/// Why a corpus could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum WriteError {
+    /// A file could not be written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The WAV encoder failed.
+    #[error("{}: {source}", path.display())]
+    Wav {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: hound::Error,
+    },
+}
+
+/// Writes `path` via a temporary file in the same folder and a rename, so a reader never sees
+/// a half-written file.
+fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), WriteError>,
+) -> Result<(), WriteError> {
+    let tmp = path.with_extension(format!(
+        "{}.partial",
+        path.extension().and_then(|e| e.to_str()).unwrap_or("tmp")
+    ));
+    write(&tmp)?;
+    std::fs::rename(&tmp, path).map_err(|source| WriteError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Writes one take as `DIR/<stem>.wav` and `DIR/<stem>.bvh`.
+pub fn write_take(take: &Take, dir: &Path) -> Result<(), WriteError> {
+    let wav = dir.join(format!("{}.wav", take.stem));
+    write_atomic(&wav, |tmp| {
+        let spec = hound::WavSpec {
+            channels: 1,
+            sample_rate: AUDIO_RATE,
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+        };
+        let wrap = |source| WriteError::Wav {
+            path: wav.clone(),
+            source,
+        };
+        let mut w = hound::WavWriter::create(tmp, spec).map_err(wrap)?;
+        for &s in &take.audio {
+            w.write_sample(s).map_err(wrap)?;
+        }
+        w.finalize().map_err(wrap)
+    })?;
+    let bvh = dir.join(format!("{}.bvh", take.stem));
+    write_atomic(&bvh, |tmp| {
+        crate::motion::write_bvh_file(&take.motion(), tmp).map_err(|source| WriteError::Io {
+            path: bvh.clone(),
+            source,
+        })
+    })
+}
+
+/// Writes `truth.json`.
+pub fn write_truth(truth: &Truth, dir: &Path) -> Result<(), WriteError> {
+    let path = dir.join("truth.json");
+    write_atomic(&path, |tmp| {
+        let text = serde_json::to_string_pretty(truth).expect("truth serializes");
+        std::fs::write(tmp, text).map_err(|source| WriteError::Io {
+            path: path.clone(),
+            source,
+        })
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -175,5 +294,81 @@ mod tests {
         }
         let err = (total_found as f64 - total_true as f64).abs() / total_true as f64;
         assert!(err < 0.10, "found {total_found} of {total_true}");
+    }
+
+    #[test]
+    fn motion_is_plausible_and_states_shape_hand_height() {
+        use crate::motion::{analyze, EffectorSpec, SegmentParams};
+        let speaker = speaker_for(3);
+        let take = generate_take(3, 0, 60.0, &speaker);
+        let m = take.motion();
+        assert_eq!(m.frames(), 1800);
+        let a = analyze(&m, &EffectorSpec::default(), &SegmentParams::default()).unwrap();
+        // Hands stay between the floor and above the head, on the body's scale (cm).
+        for f in 0..m.frames() {
+            for p in a.positions.frame(f) {
+                assert!(p[1] > 20.0 && p[1] < 230.0, "hand height {}", p[1]);
+            }
+        }
+        // Mean right-hand height per planted state follows the states' elevations:
+        // subdued < calm < emphatic < animated.
+        let mut sum = [0.0f64; 4];
+        let mut n = [0usize; 4];
+        for f in 0..m.frames() {
+            let st = take
+                .truth
+                .state_runs
+                .iter()
+                .find(|r| (f as f64 / 30.0) < r.end_s)
+                .unwrap()
+                .state;
+            sum[st] += a.positions.get(f, 1)[1];
+            n[st] += 1;
+        }
+        let mean: Vec<f64> = (0..4).map(|s| sum[s] / n[s].max(1) as f64).collect();
+        eprintln!("mean right-hand height by state: {mean:?}");
+        assert!(
+            mean[3] < mean[0] && mean[0] < mean[1] && mean[1] < mean[2],
+            "{mean:?}"
+        );
+    }
+
+    #[test]
+    fn written_corpus_reads_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let (takes, truth) = generate(
+            &SynthParams {
+                minutes: 0.25,
+                seed: 5,
+                take_seconds: 60.0,
+            },
+            |_, _| {},
+        );
+        for t in &takes {
+            write_take(t, dir.path()).unwrap();
+        }
+        write_truth(&truth, dir.path()).unwrap();
+        let m = crate::motion::read_bvh(dir.path().join("take_000.bvh")).unwrap();
+        assert_eq!(m.frames(), takes[0].frames);
+        let pcm = crate::audio::load_wav(dir.path().join("take_000.wav")).unwrap();
+        assert_eq!(pcm.samples, takes[0].audio);
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("truth.json")).unwrap())
+                .unwrap();
+        assert_eq!(
+            json["takes"][0]["syllables"].as_array().unwrap().len(),
+            takes[0].truth.syllables.len()
+        );
+        // Same seed, same bytes.
+        let (again, _) = generate(
+            &SynthParams {
+                minutes: 0.25,
+                seed: 5,
+                take_seconds: 60.0,
+            },
+            |_, _| {},
+        );
+        assert_eq!(again[0].audio, takes[0].audio);
+        assert_eq!(again[0].motion, takes[0].motion);
     }
 }

@@ -97,7 +97,7 @@ pub fn styles() -> [Style; 4] {
             syllable_s: 0.21,
             phrase_len: (4, 9),
             pause_s: 0.4,
-            elevation: 12.0,
+            elevation: 28.0,
             swing: 55.0,
             flexion: 50.0,
             spread: 15.0,

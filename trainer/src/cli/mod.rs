@@ -1,0 +1,80 @@
+//! The `gesture-train` command line: argument parsing into validated settings and dispatch to
+//! the library. Every command prints what it did to stdout and progress to stderr; errors are
+//! one line, and the binary exits with status 2 on any error.
+
+mod stats;
+mod synth;
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+/// Learns gesture controllers from motion capture with speech (BVH + WAV).
+#[derive(Debug, Parser)]
+#[command(name = "gesture-train", version, about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Generate a synthetic speech+motion corpus with planted truth (truth.json).
+    Synth(synth::SynthArgs),
+    /// Summarize a corpus: durations, segments, kinematics, syllables per file.
+    CorpusStats(stats::StatsArgs),
+}
+
+/// Options shared by commands that read a corpus.
+#[derive(Debug, Clone, clap::Args)]
+pub struct CorpusArgs {
+    /// End-effector joints (default: the two hands, found by common names).
+    #[arg(long, value_delimiter = ',')]
+    pub effectors: Vec<String>,
+    /// Largest accepted difference between audio and motion length, in seconds.
+    #[arg(long, default_value_t = 0.5)]
+    pub max_mismatch: f64,
+}
+
+impl CorpusArgs {
+    /// Load options from the arguments.
+    pub fn options(&self) -> crate::corpus::LoadOptions {
+        let mut o = crate::corpus::LoadOptions::default();
+        if !self.effectors.is_empty() {
+            o.effectors = crate::motion::EffectorSpec::joints(self.effectors.iter().cloned());
+        }
+        o.max_mismatch_s = self.max_mismatch;
+        o
+    }
+}
+
+/// An error of any command, printed as one line.
+pub type CliError = Box<dyn std::error::Error + Send + Sync>;
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Synth(a) => synth::run(&a),
+        Command::CorpusStats(a) => stats::run(&a),
+    }
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+pub(crate) fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new(len);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} ({elapsed})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    pb.set_message(what.to_string());
+    pb
+}
+
+/// Checks that an output folder can be created.
+pub(crate) fn ensure_dir(dir: &PathBuf) -> Result<(), CliError> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("{}: cannot create folder: {e}", dir.display()).into())
+}
