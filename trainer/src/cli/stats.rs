@@ -160,7 +160,10 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     pb.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if a.json {
-        let total_motion: f64 = stats.iter().filter_map(|s| s.motion_s).sum();
+        let total_motion = stats
+            .iter()
+            .filter_map(|s| s.motion_s)
+            .fold(0.0, |a, b| a + b);
         let v = serde_json::json!({ "takes": stats, "total_motion_s": total_motion, "elapsed_s": elapsed });
         println!("{v}");
         return Ok(());
@@ -206,8 +209,15 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
             );
         }
     }
-    let total_motion: f64 = stats.iter().filter_map(|s| s.motion_s).sum();
-    let total_audio: f64 = stats.iter().filter_map(|s| s.audio_s).sum();
+    // Summing from +0.0: an empty f64 sum is -0.0, which would print as "-0.0".
+    let total_motion = stats
+        .iter()
+        .filter_map(|s| s.motion_s)
+        .fold(0.0, |a, b| a + b);
+    let total_audio = stats
+        .iter()
+        .filter_map(|s| s.audio_s)
+        .fold(0.0, |a, b| a + b);
     let segs: usize = stats.iter().filter_map(|s| s.segments).sum();
     let syl: usize = stats.iter().filter_map(|s| s.syllables).sum();
     println!(

@@ -1,0 +1,52 @@
+//! The `gesture-train` binary: errors are one line on stderr with exit status 2.
+
+use std::process::Command;
+
+fn run(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_gesture-train"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn missing_input_is_one_line_and_status_2() {
+    let out = run(&["corpus-stats", "/definitely/not/here"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("/definitely/not/here"), "{err}");
+}
+
+#[test]
+fn synth_then_corpus_stats() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path().to_str().unwrap();
+    let out = run(&["synth", "--minutes", "0.5", "--seed", "4", "--out", d]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in ["take_000.wav", "take_000.bvh", "truth.json"] {
+        assert!(dir.path().join(f).is_file(), "{f}");
+    }
+    let out = run(&["corpus-stats", "--json", d]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let take = &v["takes"][0];
+    assert_eq!(take["frames"], 900);
+    assert_eq!(
+        take["effectors"],
+        serde_json::json!(["LeftHand", "RightHand"])
+    );
+    assert!(take["segments"].as_u64().unwrap() > 5);
+    assert!(take["syllables"].as_u64().unwrap() > 30);
+    // Bad arguments are refused before anything is written.
+    let out = run(&["synth", "--minutes", "-1", "--out", d]);
+    assert_eq!(out.status.code(), Some(2));
+}
