@@ -113,8 +113,8 @@ fn audio_shorter_than_motion_is_a_clear_error() {
     let pcm = gesture_trainer::audio::load_wav(&wav).unwrap();
     write_wav(&wav, &pcm.samples[..pcm.samples.len() / 2]);
     let err = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default())
-        .err()
-        .expect("a short WAV must be refused");
+        .map(|c| c.takes.len())
+        .expect_err("a short WAV must be refused");
     assert!(matches!(err, CorpusError::LengthMismatch { .. }), "{err}");
     let msg = err.to_string();
     assert!(
@@ -137,16 +137,18 @@ fn no_effector_and_bad_bvh_are_clear_errors() {
     )
     .unwrap();
     let msg = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default())
-        .err()
-        .expect("no hands must be refused")
+        .map(|c| c.takes.len())
+        .expect_err("no hands must be refused")
         .to_string();
     assert!(
         msg.contains("take_000.bvh") && msg.contains("hand"),
         "{msg}"
     );
     // Naming the effectors explicitly fixes it.
-    let mut opts = LoadOptions::default();
-    opts.effectors = gesture_trainer::motion::EffectorSpec::joints(["LeftPaw", "RightPaw"]);
+    let opts = LoadOptions {
+        effectors: gesture_trainer::motion::EffectorSpec::joints(["LeftPaw", "RightPaw"]),
+        ..LoadOptions::default()
+    };
     assert!(load_corpus(&[dir.path().to_path_buf()], &opts).is_ok());
     // A NaN channel value, then a truncated file: errors name the file and the line.
     let lines: Vec<&str> = text.lines().collect();
