@@ -46,6 +46,10 @@ fn synth_then_corpus_stats() {
     );
     assert!(take["segments"].as_u64().unwrap() > 5);
     assert!(take["syllables"].as_u64().unwrap() > 30);
+    // The fitted normalization: six means and six positive scales.
+    let scale = v["normalization"]["scale"].as_array().unwrap();
+    assert_eq!(scale.len(), 6);
+    assert!(scale.iter().all(|x| x.as_f64().unwrap() > 0.0));
     // Bad arguments are refused before anything is written.
     let out = run(&["synth", "--minutes", "-1", "--out", d]);
     assert_eq!(out.status.code(), Some(2));

@@ -56,6 +56,9 @@ pub struct TakeStats {
     pub syllables: Option<usize>,
     /// Pause steps.
     pub pauses: Option<usize>,
+    /// Log-scale kinematic vectors of the segments (for the corpus normalization).
+    #[serde(skip)]
+    pub y_raw: Vec<[f64; 6]>,
 }
 
 fn quantiles(mut v: Vec<f64>) -> [f64; 5] {
@@ -70,6 +73,7 @@ fn motion_part(s: &mut TakeStats, a: &TakeAnalysis, frames: usize) {
     s.motion_s = Some(frames as f64 * a.frame_time);
     s.effectors = a.effectors.names.clone();
     s.segments = Some(a.segments.len());
+    s.y_raw = a.y_raw.clone();
     s.threshold = Some(a.threshold);
     if !a.segments.is_empty() {
         s.segment_s = Some(quantiles(
@@ -111,6 +115,7 @@ fn stats_of(t: &Take, args: &StatsArgs) -> Result<TakeStats, CliError> {
         kinematics: None,
         syllables: None,
         pauses: None,
+        y_raw: vec![],
     };
     let count = |steps: &[gesture_runtime::prosody::Step], k: StepKind| {
         steps.iter().filter(|x| x.kind == k).count()
@@ -164,7 +169,16 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
             .iter()
             .filter_map(|s| s.motion_s)
             .fold(0.0, |a, b| a + b);
-        let v = serde_json::json!({ "takes": stats, "total_motion_s": total_motion, "elapsed_s": elapsed });
+        // The per-dimension normalization of the log kinematic parameters fitted on this corpus
+        // (the paper's W and B); `fit` stores the same one in the model.
+        let all: Vec<[f64; 6]> = stats.iter().flat_map(|s| s.y_raw.iter().copied()).collect();
+        let norm = crate::motion::Normalization::fit(&all).ok();
+        let v = serde_json::json!({
+            "takes": stats,
+            "total_motion_s": total_motion,
+            "normalization": norm,
+            "elapsed_s": elapsed,
+        });
         println!("{v}");
         return Ok(());
     }
