@@ -2,6 +2,8 @@
 //! the library. Every command prints what it did to stdout and progress to stderr; errors are
 //! one line, and the binary exits with status 2 on any error.
 
+mod eval_inference;
+mod fit;
 mod stats;
 mod synth;
 
@@ -25,6 +27,10 @@ pub enum Command {
     Synth(synth::SynthArgs),
     /// Summarize a corpus: durations, segments, kinematics, syllables per file.
     CorpusStats(stats::StatsArgs),
+    /// Train the inference layer (HMM, prosody mixture, CRF) and write the model file.
+    Fit(fit::FitArgs),
+    /// Compare CRF, remapped HMM and prior on held-out data (the paper's Fig. 4).
+    EvalInference(eval_inference::EvalArgs),
 }
 
 /// Options shared by commands that read a corpus.
@@ -58,6 +64,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Synth(a) => synth::run(&a),
         Command::CorpusStats(a) => stats::run(&a),
+        Command::Fit(a) => fit::run(&a),
+        Command::EvalInference(a) => eval_inference::run(&a),
     }
 }
 

@@ -5,6 +5,10 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod crf;
+pub mod eval;
 pub mod gaussian;
 pub mod gmm;
 pub mod hmm;
+pub mod model;
+pub mod quantize;
+pub mod train;

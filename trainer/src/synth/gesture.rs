@@ -2,16 +2,21 @@
 //! shaped by the planted style state.
 //!
 //! The dominant (right) arm makes strokes from pose to pose with a minimum-jerk time profile
-//! (Flash & Hogan), so speed falls to zero between strokes as in human gesture phases; each
-//! stroke's target is drawn around the state's mean arm elevation, forward swing and elbow
-//! flexion, its duration around the state's stroke time, and its path bows sideways by the
-//! state's bow (the path's curvature). After a stroke the hand may hold, with a faint tremor.
+//! (Flash & Hogan), so speed falls to zero between strokes as in human gesture phases. Strokes
+//! alternate out to an extended pose and back to a home pose, both drawn around the state's
+//! mean arm elevation, forward swing and elbow flexion (`reach` apart, plus `spread` noise);
+//! a stroke's duration is drawn around the state's stroke time, and its path bows sideways by
+//! the state's bow (the path's curvature). After a stroke the hand may hold, with a faint tremor.
 //! The other arm mirrors the strokes in two-handed states and otherwise drifts near rest on
 //! the same timing. Spine, neck and head sway a little. Units: centimetres, Y up, facing +Z.
 //!
-//! Angles are semantic and mapped to BVH channels (Z Y X order, `R = Rz Ry Rx` on column
-//! vectors) per side: left arm `Z = elevation`, `Y = -swing`, forearm `Y = -flexion`; the right
-//! arm mirrors the signs. Elevation -90 hangs the arm down, 0 holds it out sideways.
+//! Angles are semantic and mapped to BVH channels per side: left arm `Z = elevation`,
+//! `Y = -swing`, forearm `Y = -flexion`; the right arm mirrors the signs. Elevation -90 hangs
+//! the arm down, 0 holds it out sideways, 90 raises it. The upper arms use channel order
+//! `Yrotation Zrotation Xrotation` (`R = Ry Rz Rx`): the arm is elevated in the frontal plane
+//! first and then swung forward about the vertical, so the hand's height depends on the
+//! elevation alone (with Z outermost, a forward-swung arm would barely rise). Every other joint
+//! uses `Zrotation Yrotation Xrotation`.
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -37,7 +42,7 @@ pub struct JointSpec {
 }
 
 /// The upper-body skeleton. The root has 6 channels (Xposition Yposition Zposition Zrotation
-/// Yrotation Xrotation); every other joint has 3 (Zrotation Yrotation Xrotation).
+/// Yrotation Xrotation); every other joint has 3 (see the module docs for their order).
 pub const SKELETON: [JointSpec; 13] = [
     JointSpec {
         name: "Hips",
@@ -119,6 +124,11 @@ pub const SKELETON: [JointSpec; 13] = [
     },
 ];
 
+/// Whether joint `j` is an upper arm (channel order Y Z X).
+pub fn is_upper_arm(j: usize) -> bool {
+    SKELETON[j].name.ends_with("Arm") && !SKELETON[j].name.ends_with("ForeArm")
+}
+
 /// Channels per frame: 6 for the root, 3 for each other joint.
 pub const CHANNELS: usize = 6 + 3 * (SKELETON.len() - 1);
 
@@ -171,7 +181,7 @@ impl ArmPose {
     }
     fn clamp(self) -> Self {
         Self {
-            elevation: self.elevation.clamp(-88.0, 40.0),
+            elevation: self.elevation.clamp(-88.0, 75.0),
             swing: self.swing.clamp(-5.0, 85.0),
             flexion: self.flexion.clamp(2.0, 135.0),
         }
@@ -211,15 +221,19 @@ pub fn generate(
     let mut segments = Vec::new();
     let mut pose = [ArmPose::REST, ArmPose::REST];
     let mut t = 0.0;
+    let mut out = true;
     while t < duration_s {
         let state = track.at(t);
         let s = &styles[state];
-        let dur = (s.stroke_s * (0.2 * gauss(rng)).exp()).clamp(0.2, 2.5);
+        let dur = (s.stroke_s * (0.1 * gauss(rng)).exp()).clamp(0.2, 2.5);
         let end = (t + dur).min(duration_s);
+        // Out: higher, further forward, straighter; back: the opposite.
+        let dir = if out { 1.0 } else { -1.0 };
+        out = !out;
         let right = ArmPose {
-            elevation: s.elevation + s.spread * gauss(rng),
-            swing: s.swing + s.spread * gauss(rng),
-            flexion: s.flexion + s.spread * gauss(rng),
+            elevation: s.elevation + dir * 0.5 * s.reach + s.spread * gauss(rng),
+            swing: s.swing + dir * s.reach + s.spread * gauss(rng),
+            flexion: s.flexion - dir * s.reach + s.spread * gauss(rng),
         }
         .clamp();
         let left = if s.two_handed {
@@ -256,7 +270,7 @@ pub fn generate(
         pose = to;
         t = end;
         if t < duration_s && rng.random_bool(s.hold_prob) {
-            let hold = (s.hold_s * (0.3 * gauss(rng)).exp()).clamp(0.15, 2.0);
+            let hold = (s.hold_s * (0.15 * gauss(rng)).exp()).clamp(0.15, 2.0);
             let end = (t + hold).min(duration_s);
             moves.push(Move {
                 start: t,
@@ -316,12 +330,13 @@ pub fn generate(
             p.elevation += 0.4 * tremor[3 * arm];
             p.swing += 0.4 * tremor[3 * arm + 1];
             p.flexion += 0.5 * tremor[3 * arm + 2];
-            // Channel layout: root 0..6, then joint j (1-based) at 6 + 3 (j - 1): Z, Y, X.
+            // Channel layout: root 0..6, then joint j (1-based) at 6 + 3 (j - 1); upper arm
+            // channels are Y, Z, X, forearm channels Z, Y, X.
             let (arm_j, fore_j) = if arm == 0 { (6, 7) } else { (10, 11) };
             let a = 6 + 3 * (arm_j - 1);
             let fa = 6 + 3 * (fore_j - 1);
-            row[a] = side * p.elevation;
-            row[a + 1] = -side * p.swing;
+            row[a] = -side * p.swing;
+            row[a + 1] = side * p.elevation;
             row[fa + 1] = -side * p.flexion;
         }
     }

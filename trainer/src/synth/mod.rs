@@ -158,7 +158,8 @@ pub fn skeleton() -> Skeleton {
     use Channel::*;
     let joints = gesture::SKELETON
         .iter()
-        .map(|j| Joint {
+        .enumerate()
+        .map(|(i, j)| Joint {
             name: j.name.to_string(),
             parent: j.parent,
             offset: j.offset,
@@ -166,6 +167,8 @@ pub fn skeleton() -> Skeleton {
                 vec![
                     Xposition, Yposition, Zposition, Zrotation, Yrotation, Xrotation,
                 ]
+            } else if gesture::is_upper_arm(i) {
+                vec![Yrotation, Zrotation, Xrotation]
             } else {
                 vec![Zrotation, Yrotation, Xrotation]
             },

@@ -38,6 +38,9 @@ pub struct Style {
     pub flexion: f64,
     /// Spread of stroke targets around the means (same units).
     pub spread: f64,
+    /// Half the distance between the home and the extended pose (degrees): strokes go out
+    /// and back, as gesture strokes and retractions do, so speed dips between strokes.
+    pub reach: f64,
     /// Mean stroke duration (s).
     pub stroke_s: f64,
     /// Sideways bow of a stroke's path (degrees at mid-stroke): the path's curvature.
@@ -61,15 +64,16 @@ pub fn styles() -> [Style; 4] {
             syllable_s: 0.24,
             phrase_len: (4, 8),
             pause_s: 0.5,
-            elevation: -45.0,
-            swing: 30.0,
-            flexion: 60.0,
-            spread: 12.0,
-            stroke_s: 0.75,
-            bow: 8.0,
-            hold_prob: 0.4,
-            hold_s: 0.5,
-            two_handed: false,
+            elevation: -40.0,
+            swing: 25.0,
+            flexion: 30.0,
+            spread: 4.0,
+            stroke_s: 1.1,
+            reach: 20.0,
+            bow: 4.0,
+            hold_prob: 0.05,
+            hold_s: 0.35,
+            two_handed: true,
         },
         Style {
             name: "emphatic",
@@ -79,14 +83,15 @@ pub fn styles() -> [Style; 4] {
             syllable_s: 0.19,
             phrase_len: (5, 10),
             pause_s: 0.35,
-            elevation: -10.0,
+            elevation: -5.0,
             swing: 45.0,
-            flexion: 85.0,
-            spread: 22.0,
-            stroke_s: 0.38,
-            bow: 3.0,
-            hold_prob: 0.15,
-            hold_s: 0.3,
+            flexion: 30.0,
+            spread: 5.0,
+            stroke_s: 0.25,
+            reach: 10.0,
+            bow: 2.0,
+            hold_prob: 0.05,
+            hold_s: 0.25,
             two_handed: true,
         },
         Style {
@@ -97,15 +102,16 @@ pub fn styles() -> [Style; 4] {
             syllable_s: 0.21,
             phrase_len: (4, 9),
             pause_s: 0.4,
-            elevation: 28.0,
-            swing: 55.0,
-            flexion: 50.0,
-            spread: 15.0,
-            stroke_s: 0.55,
-            bow: 25.0,
-            hold_prob: 0.2,
-            hold_s: 0.4,
-            two_handed: false,
+            elevation: 65.0,
+            swing: 50.0,
+            flexion: 30.0,
+            spread: 4.0,
+            stroke_s: 0.8,
+            reach: 22.0,
+            bow: 30.0,
+            hold_prob: 0.05,
+            hold_s: 0.3,
+            two_handed: true,
         },
         Style {
             name: "subdued",
@@ -115,12 +121,13 @@ pub fn styles() -> [Style; 4] {
             syllable_s: 0.28,
             phrase_len: (2, 5),
             pause_s: 0.9,
-            elevation: -72.0,
-            swing: 10.0,
-            flexion: 25.0,
-            spread: 5.0,
-            stroke_s: 1.3,
-            bow: 4.0,
+            elevation: -78.0,
+            swing: 8.0,
+            flexion: 20.0,
+            spread: 3.0,
+            stroke_s: 1.5,
+            reach: 2.0,
+            bow: 3.0,
             hold_prob: 0.5,
             hold_s: 0.8,
             two_handed: false,
@@ -139,7 +146,7 @@ pub struct StateRun {
     pub state: usize,
 }
 
-/// Piecewise-constant state over a take: runs of 2.5-7 s, each followed by a different state
+/// Piecewise-constant state over a take: runs of 5-12 s, each followed by a different state
 /// chosen uniformly (a semi-Markov chain).
 #[derive(Clone, Debug, Serialize)]
 pub struct StateTrack {
@@ -154,7 +161,7 @@ impl StateTrack {
         let mut t = 0.0;
         let mut state = rng.random_range(0..n_states);
         while t < duration_s {
-            let len = rng.random_range(2.5..7.0);
+            let len = rng.random_range(5.0..12.0);
             let end = (t + len).min(duration_s);
             runs.push(StateRun {
                 start_s: t,

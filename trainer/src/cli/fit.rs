@@ -1,0 +1,94 @@
+//! `gesture-train fit`: trains the inference layer and writes the model file.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::{CliError, CorpusArgs};
+use crate::corpus::load_corpus;
+use crate::inference::train::{fit, sequences, FitConfig};
+
+/// Arguments of `fit`.
+#[derive(Debug, clap::Args)]
+pub struct FitArgs {
+    /// Training corpus: BVH+WAV files or folders.
+    #[arg(long, required = true, num_args = 1..)]
+    pub corpus: Vec<PathBuf>,
+    /// Hidden states S.
+    #[arg(long, default_value_t = 12)]
+    pub states: usize,
+    /// Prosody clusters K.
+    #[arg(long, default_value_t = 8)]
+    pub clusters: usize,
+    /// CRF input window W (syllables, causal).
+    #[arg(long, default_value_t = 4)]
+    pub window: usize,
+    /// HMM restarts (run in parallel).
+    #[arg(long, default_value_t = 4)]
+    pub restarts: usize,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Use only steps whose midpoint is in START:END seconds of each take.
+    #[arg(long, value_parser = parse_span)]
+    pub span: Option<(f64, f64)>,
+    /// Output model file.
+    #[arg(long)]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub load: CorpusArgs,
+}
+
+/// Parses `START:END` (seconds).
+pub fn parse_span(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = s
+        .split_once(':')
+        .ok_or("expected START:END in seconds, e.g. 0:40")?;
+    let a: f64 = if a.is_empty() {
+        0.0
+    } else {
+        a.parse().map_err(|_| format!("bad start `{a}`"))?
+    };
+    let b: f64 = if b.is_empty() {
+        f64::INFINITY
+    } else {
+        b.parse().map_err(|_| format!("bad end `{b}`"))?
+    };
+    if !(a >= 0.0 && b > a) {
+        return Err(format!("span {s}: need 0 <= START < END"));
+    }
+    Ok((a, b))
+}
+
+pub fn run(a: &FitArgs) -> Result<(), CliError> {
+    let start = Instant::now();
+    let corpus = load_corpus(&a.corpus, &a.load.options())?;
+    let (seqs, segs) = sequences(&corpus, a.span);
+    let steps: usize = seqs.iter().map(|s| s.len()).sum();
+    eprintln!(
+        "loaded {} takes, {steps} steps, {} segments in {:.2} s",
+        corpus.takes.len(),
+        segs.len(),
+        corpus.load_s
+    );
+    let cfg = FitConfig {
+        states: a.states,
+        clusters: a.clusters,
+        window: a.window,
+        restarts: a.restarts,
+        seed: a.seed,
+        ..FitConfig::default()
+    };
+    let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;
+    model.save(&a.out)?;
+    println!(
+        "wrote {}: {}; fit {:.2} s (hmm {:.2}, gmm {:.2}, crf {:.2}), total {:.2} s",
+        a.out.display(),
+        model.summary,
+        report.seconds.iter().sum::<f64>(),
+        report.seconds[0],
+        report.seconds[1],
+        report.seconds[2],
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

@@ -1,0 +1,318 @@
+//! The trained inference model and its file: what `gesture-train fit` writes and `pack` reads.
+//!
+//! A JSON document with a format tag (`gesture-inference-model`) and a version; readers refuse
+//! other versions with a message saying which they support. It holds everything needed to turn
+//! prosody steps into beliefs and beliefs into expected kinematics: the front-end settings it was
+//! trained with, the normalization of the log kinematic parameters, the HMM (its state
+//! Gaussians give `P(y | state)`), the prosody mixture and the CRF. Written atomically.
+
+use std::path::Path;
+
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+use super::crf::Crf;
+use super::gaussian::Gaussian;
+use super::gmm::{Component, Gmm};
+use super::hmm::Hmm;
+use crate::motion::Normalization;
+
+/// Format tag of the model file.
+pub const FORMAT: &str = "gesture-inference-model";
+/// Current version of the model file.
+pub const VERSION: u32 = 1;
+
+/// A Gaussian as stored (mean and row-major covariance).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct GaussianFile {
+    /// Mean.
+    pub mean: Vec<f64>,
+    /// Covariance, row-major.
+    pub cov: Vec<f64>,
+}
+
+impl GaussianFile {
+    fn from(g: &Gaussian) -> Self {
+        Self {
+            mean: g.mean().as_slice().to_vec(),
+            cov: g.cov().transpose().as_slice().to_vec(),
+        }
+    }
+    fn to_gaussian(&self) -> Option<Gaussian> {
+        let d = self.mean.len();
+        if self.cov.len() != d * d {
+            return None;
+        }
+        Gaussian::new(
+            DVector::from_vec(self.mean.clone()),
+            DMatrix::from_row_slice(d, d, &self.cov),
+        )
+    }
+}
+
+/// The HMM over kinematic parameters.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct HmmFile {
+    /// Initial probabilities.
+    pub init: Vec<f64>,
+    /// Transition matrix, row-major.
+    pub trans: Vec<f64>,
+    /// State Gaussians over normalized kinematic parameters.
+    pub states: Vec<GaussianFile>,
+    /// Covariance floor used.
+    pub eps: f64,
+}
+
+/// One prosody cluster.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ClusterFile {
+    /// Mixing weight.
+    pub weight: f64,
+    /// P(voiced).
+    pub voiced: f64,
+    /// Gaussian over (intensity, length).
+    pub obs: GaussianFile,
+    /// F0 regression coefficients.
+    pub coef: [f64; 3],
+    /// F0 residual variance.
+    pub f0_var: f64,
+}
+
+/// The CRF weights.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CrfFile {
+    /// Window.
+    pub window: usize,
+    /// Initial weights.
+    pub init: Vec<f64>,
+    /// Transition weights (row-major from -> to).
+    pub trans: Vec<f64>,
+    /// Observation weights `[(j * W + w) * K + k]`.
+    pub obs: Vec<f64>,
+}
+
+/// Front-end settings the model was trained with (the device must use the same).
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
+pub struct FrontEndFile {
+    /// Sample rate (Hz).
+    pub sample_rate_hz: u32,
+}
+
+/// The whole model file.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ModelFile {
+    /// [`FORMAT`].
+    pub format: String,
+    /// [`VERSION`].
+    pub version: u32,
+    /// Front-end settings.
+    pub front_end: FrontEndFile,
+    /// Normalization of the log kinematic parameters (T, D, V, A, C, H).
+    pub normalization: Normalization,
+    /// HMM.
+    pub hmm: HmmFile,
+    /// Prosody mixture.
+    pub gmm: Vec<ClusterFile>,
+    /// CRF.
+    pub crf: CrfFile,
+    /// State frequencies on the training data (the "prior" baseline).
+    pub state_prior: Vec<f64>,
+    /// Human-readable training summary.
+    pub summary: String,
+}
+
+/// A model in memory.
+#[derive(Clone, Debug)]
+pub struct InferenceModel {
+    /// Front-end rate.
+    pub sample_rate_hz: u32,
+    /// Kinematic normalization.
+    pub normalization: Normalization,
+    /// HMM.
+    pub hmm: Hmm,
+    /// Prosody mixture.
+    pub gmm: Gmm,
+    /// CRF.
+    pub crf: Crf,
+    /// State frequencies on the training data.
+    pub state_prior: Vec<f64>,
+    /// Training summary.
+    pub summary: String,
+}
+
+/// Why a model file could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// I/O.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// Not JSON, or not this format.
+    #[error("{path}: not a gesture inference model ({reason})")]
+    Format {
+        /// The file.
+        path: String,
+        /// What was wrong.
+        reason: String,
+    },
+    /// Another version.
+    #[error("{path}: model format version {found}, this build reads version {VERSION}: retrain with `gesture-train fit`")]
+    Version {
+        /// The file.
+        path: String,
+        /// Version found.
+        found: u32,
+    },
+}
+
+impl InferenceModel {
+    /// Number of hidden states.
+    pub fn states(&self) -> usize {
+        self.hmm.states()
+    }
+
+    /// The file form.
+    pub fn to_file(&self) -> ModelFile {
+        ModelFile {
+            format: FORMAT.into(),
+            version: VERSION,
+            front_end: FrontEndFile {
+                sample_rate_hz: self.sample_rate_hz,
+            },
+            normalization: self.normalization,
+            hmm: HmmFile {
+                init: self.hmm.init.clone(),
+                trans: self.hmm.trans.clone(),
+                states: self.hmm.emit.iter().map(GaussianFile::from).collect(),
+                eps: self.hmm.eps,
+            },
+            gmm: self
+                .gmm
+                .components
+                .iter()
+                .map(|c| ClusterFile {
+                    weight: c.weight,
+                    voiced: c.voiced,
+                    obs: GaussianFile::from(&c.obs),
+                    coef: c.coef,
+                    f0_var: c.f0_var,
+                })
+                .collect(),
+            crf: CrfFile {
+                window: self.crf.window,
+                init: self.crf.init.clone(),
+                trans: self.crf.trans.clone(),
+                obs: self.crf.obs.clone(),
+            },
+            state_prior: self.state_prior.clone(),
+            summary: self.summary.clone(),
+        }
+    }
+
+    /// From the file form, checking every dimension.
+    pub fn from_file(f: ModelFile, path: &str) -> Result<Self, ModelError> {
+        let bad = |reason: String| ModelError::Format {
+            path: path.into(),
+            reason,
+        };
+        if f.format != FORMAT {
+            return Err(bad(format!("format tag `{}`", f.format)));
+        }
+        if f.version != VERSION {
+            return Err(ModelError::Version {
+                path: path.into(),
+                found: f.version,
+            });
+        }
+        let s = f.hmm.init.len();
+        let k = f.gmm.len();
+        let w = f.crf.window;
+        if s == 0
+            || f.hmm.trans.len() != s * s
+            || f.hmm.states.len() != s
+            || f.state_prior.len() != s
+        {
+            return Err(bad("inconsistent HMM dimensions".into()));
+        }
+        if k == 0
+            || w == 0
+            || f.crf.init.len() != s
+            || f.crf.trans.len() != s * s
+            || f.crf.obs.len() != s * w * k
+        {
+            return Err(bad("inconsistent CRF dimensions".into()));
+        }
+        let emit = f
+            .hmm
+            .states
+            .iter()
+            .map(|g| g.to_gaussian().filter(|g| g.dim() == 6))
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| bad("a state Gaussian is not a valid 6-D Gaussian".into()))?;
+        let components = f
+            .gmm
+            .iter()
+            .map(|c| {
+                Some(Component {
+                    weight: c.weight,
+                    voiced: c.voiced,
+                    obs: c.obs.to_gaussian().filter(|g| g.dim() == 2)?,
+                    coef: c.coef,
+                    f0_var: c.f0_var,
+                })
+            })
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| bad("a prosody cluster is not valid".into()))?;
+        Ok(Self {
+            sample_rate_hz: f.front_end.sample_rate_hz,
+            normalization: f.normalization,
+            hmm: Hmm {
+                init: f.hmm.init,
+                trans: f.hmm.trans,
+                emit,
+                eps: f.hmm.eps,
+            },
+            gmm: Gmm { components },
+            crf: Crf {
+                states: s,
+                clusters: k,
+                window: w,
+                init: f.crf.init,
+                trans: f.crf.trans,
+                obs: f.crf.obs,
+            },
+            state_prior: f.state_prior,
+            summary: f.summary,
+        })
+    }
+
+    /// Writes the model atomically (temporary file, then rename).
+    pub fn save(&self, path: &Path) -> Result<(), ModelError> {
+        let io = |source| ModelError::Io {
+            path: path.display().to_string(),
+            source,
+        };
+        let text = serde_json::to_string_pretty(&self.to_file()).expect("model serializes");
+        let tmp = path.with_extension("partial");
+        std::fs::write(&tmp, text).map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
+    }
+
+    /// Reads a model file.
+    pub fn load(path: &Path) -> Result<Self, ModelError> {
+        let p = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+            path: p.clone(),
+            source,
+        })?;
+        let f: ModelFile = serde_json::from_str(&text).map_err(|e| ModelError::Format {
+            path: p.clone(),
+            reason: e.to_string(),
+        })?;
+        Self::from_file(f, &p)
+    }
+}
