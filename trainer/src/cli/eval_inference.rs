@@ -46,6 +46,10 @@ pub struct EvalArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// CRF L2 regularization per training step (default: chosen by validation on the last
+    /// 20% of each training take).
+    #[arg(long)]
+    pub l2: Option<f64>,
     /// Use only training steps in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub train_span: Option<(f64, f64)>,
@@ -148,6 +152,7 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         clusters: a.clusters,
         restarts: a.restarts,
         seed: a.seed,
+        l2: a.l2,
         ..FitConfig::default()
     };
     let log = |line: &str| eprintln!("{line}");

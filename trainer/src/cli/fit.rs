@@ -28,6 +28,10 @@ pub struct FitArgs {
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// CRF L2 regularization per training step (default: chosen by validation on the last
+    /// 20% of each training take).
+    #[arg(long)]
+    pub l2: Option<f64>,
     /// Use only steps whose midpoint is in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub span: Option<(f64, f64)>,
@@ -76,6 +80,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         window: a.window,
         restarts: a.restarts,
         seed: a.seed,
+        l2: a.l2,
         ..FitConfig::default()
     };
     let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;

@@ -6,9 +6,14 @@
 //! - The covariance floor and a small Dirichlet pseudo-count on the initial and transition
 //!   probabilities are priors, so EM is a MAP-EM: the reported objective (log-likelihood plus
 //!   log-prior) never decreases from one iteration to the next (tested).
-//! - Initialization: k-means++ seeding and a few Lloyd iterations from a seeded RNG; each
-//!   restart uses its own seed and restarts run in parallel (rayon). The best objective wins,
-//!   ties broken by restart index, so results do not depend on thread timing.
+//! - Initialization: k-means++ seeding and a few Lloyd iterations from a seeded RNG, on the
+//!   observations *smoothed over a few neighbouring steps* (moving average within each
+//!   sequence, [`HmmConfig::init_smoothing`] steps either side). Hidden states are meant to be
+//!   slow (a gesture style lasts many steps) while single steps also vary with fast gesture
+//!   phases; clustering smoothed vectors seeds EM on the slow structure, and EM then refines on
+//!   the raw observations. Each restart uses its own seed and restarts run in parallel (rayon).
+//!   The best objective wins, ties broken by restart index, so results do not depend on thread
+//!   timing.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -36,6 +41,8 @@ pub struct HmmConfig {
     pub pseudo_count: f64,
     /// Seed of the first restart.
     pub seed: u64,
+    /// Steps either side averaged for the k-means initialization (0 = raw observations).
+    pub init_smoothing: usize,
 }
 
 impl Default for HmmConfig {
@@ -48,6 +55,7 @@ impl Default for HmmConfig {
             cov_floor: 1e-3,
             pseudo_count: 1e-2,
             seed: 1,
+            init_smoothing: 4,
         }
     }
 }
@@ -369,6 +377,19 @@ fn kmeans(points: &[&Vec<f64>], k: usize, rng: &mut ChaCha8Rng) -> Vec<usize> {
     assign
 }
 
+/// Moving average of a sequence over `half` steps either side (truncated at the ends).
+fn smooth(q: &[Vec<f64>], half: usize) -> Vec<Vec<f64>> {
+    (0..q.len())
+        .map(|t| {
+            let (a, b) = (t.saturating_sub(half), (t + half + 1).min(q.len()));
+            let n = (b - a) as f64;
+            (0..q[t].len())
+                .map(|d| q[a..b].iter().map(|v| v[d]).sum::<f64>() / n)
+                .collect()
+        })
+        .collect()
+}
+
 fn em_run(
     seqs: &[Seq],
     cfg: &HmmConfig,
@@ -379,12 +400,16 @@ fn em_run(
 ) -> (Hmm, RunReport) {
     let s = cfg.states;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let points: Vec<&Vec<f64>> = seqs.iter().flatten().collect();
-    let owned: Vec<Vec<f64>> = points.iter().map(|p| (*p).clone()).collect();
+    let owned: Vec<Vec<f64>> = seqs.iter().flatten().cloned().collect();
     let dims = owned[0].len();
     let centre_mean: Vec<f64> = (0..dims)
         .map(|d| owned.iter().map(|v| v[d]).sum::<f64>() / owned.len() as f64)
         .collect();
+    let smoothed: Vec<Vec<f64>> = seqs
+        .iter()
+        .flat_map(|q| smooth(q, cfg.init_smoothing))
+        .collect();
+    let points: Vec<&Vec<f64>> = smoothed.iter().collect();
     let assign = kmeans(&points, s, &mut rng);
     let emit: Vec<Gaussian> = (0..s)
         .map(|k| {

@@ -91,8 +91,8 @@ pub struct FitConfig {
     pub restarts: usize,
     /// Seed.
     pub seed: u64,
-    /// CRF L2 strength per training step.
-    pub l2: f64,
+    /// CRF L2 strength per training step; `None` chooses it by validation (see [`choose_l2`]).
+    pub l2: Option<f64>,
     /// Front-end rate the features came from.
     pub sample_rate_hz: u32,
 }
@@ -105,7 +105,7 @@ impl Default for FitConfig {
             window: 4,
             restarts: 4,
             seed: 1,
-            l2: 1e-3,
+            l2: None,
             sample_rate_hz: gesture_runtime::prosody::DEFAULT_RATE_HZ,
         }
     }
@@ -158,6 +158,8 @@ pub struct FitReport {
     pub crf_iterations: u64,
     /// CRF objective per step.
     pub crf_objective: f64,
+    /// CRF L2 used (per step).
+    pub l2: f64,
     /// Seconds per stage: HMM, GMM, CRF.
     pub seconds: [f64; 3],
 }
@@ -307,15 +309,79 @@ pub fn fit_base(
     })
 }
 
-/// Trains the CRF for window `window` on a fitted base.
+/// Candidate L2 strengths (per step) tried by [`choose_l2`].
+pub const L2_GRID: [f64; 6] = [1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3];
+
+fn split_seq(q: &TrainSeq, cut: usize) -> (TrainSeq, TrainSeq) {
+    let cut = cut.clamp(1, q.memberships.len().saturating_sub(1).max(1));
+    let a = TrainSeq {
+        memberships: q.memberships[..cut].to_vec(),
+        gamma: q.gamma[..cut].to_vec(),
+        xi: q.xi[..cut.saturating_sub(1).min(q.xi.len())].to_vec(),
+    };
+    let b = TrainSeq {
+        memberships: q.memberships[cut..].to_vec(),
+        gamma: q.gamma[cut..].to_vec(),
+        xi: q.xi[cut.min(q.xi.len())..].to_vec(),
+    };
+    (a, b)
+}
+
+/// Chooses the CRF's L2 strength by validation: trains on the first 80% of every training
+/// sequence and scores the last 20% with the CRF's own objective (expected log-likelihood of
+/// the HMM posteriors, no penalty), for each value of [`L2_GRID`]. How much to regularize
+/// depends on how much data there is and how predictable the states are from prosody, so it
+/// is measured rather than fixed. Returns the best value and its held-out score per step.
+pub fn choose_l2(
+    base: &FitBase,
+    window: usize,
+    log: &(dyn Fn(&str) + Sync),
+) -> Result<(f64, f64), FitError> {
+    let (fit_part, held): (Vec<TrainSeq>, Vec<TrainSeq>) = base
+        .train
+        .iter()
+        .filter(|q| q.memberships.len() >= 10)
+        .map(|q| split_seq(q, q.memberships.len() * 4 / 5))
+        .unzip();
+    let held_steps: usize = held.iter().map(|q| q.memberships.len()).sum();
+    let fit_steps: usize = fit_part.iter().map(|q| q.memberships.len()).sum();
+    if held_steps == 0 {
+        return Ok((1e-2, f64::NAN));
+    }
+    let (s, k) = (base.hmm.states(), base.gmm.components.len());
+    let mut best = (L2_GRID[0], f64::NEG_INFINITY);
+    for &l2 in &L2_GRID {
+        let cfg = CrfConfig {
+            window,
+            l2: l2 * fit_steps as f64,
+            ..CrfConfig::default()
+        };
+        let (crf, _) = Crf::fit(&fit_part, s, k, &cfg).map_err(FitError::Crf)?;
+        let score = crf.objective_and_gradient(&held, 0.0).0 / held_steps as f64;
+        log(&format!(
+            "crf: window {window}, l2 {l2}: held-out objective {score:.4} per step"
+        ));
+        if score > best.1 {
+            best = (l2, score);
+        }
+    }
+    Ok(best)
+}
+
+/// Trains the CRF for window `window` on a fitted base (`l2` per step; `None`: by validation).
 pub fn fit_crf(
     base: &FitBase,
     window: usize,
-    l2: f64,
+    l2: Option<f64>,
     report: &mut FitReport,
     log: &(dyn Fn(&str) + Sync),
 ) -> Result<Crf, FitError> {
     let t2 = Instant::now();
+    let l2 = match l2 {
+        Some(v) => v,
+        None => choose_l2(base, window, log)?.0,
+    };
+    report.l2 = l2;
     // `l2` is per training step: the objective is a sum over steps, so the penalty scales
     // with them and the regularization strength does not depend on the corpus size.
     let (crf, crep) = Crf::fit(
@@ -333,7 +399,7 @@ pub fn fit_crf(
     report.crf_objective = crep.objective / report.steps.max(1) as f64;
     report.seconds[2] = t2.elapsed().as_secs_f64();
     log(&format!(
-        "crf: window {window}, {} L-BFGS iterations ({}), objective {:.4} per step, {:.2} s",
+        "crf: window {window}, l2 {l2}, {} L-BFGS iterations ({}), objective {:.4} per step, {:.2} s",
         crep.iterations, crep.termination, report.crf_objective, report.seconds[2]
     ));
     Ok(crf)
@@ -350,12 +416,13 @@ pub fn fit(
     let base = fit_base(seqs, segment_y, cfg, &mut report, log)?;
     let crf = fit_crf(&base, cfg.window, cfg.l2, &mut report, log)?;
     let summary = format!(
-        "{} steps in {} sequences; S={} K={} W={}; HMM ll/step {:.3}; CRF objective/step {:.4}",
+        "{} steps in {} sequences; S={} K={} W={} l2={}; HMM ll/step {:.3}; CRF objective/step {:.4}",
         report.steps,
         seqs.len(),
         cfg.states,
         cfg.clusters,
         cfg.window,
+        report.l2,
         report.hmm_log_likelihood / report.steps as f64,
         report.crf_objective
     );

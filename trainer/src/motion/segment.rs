@@ -415,7 +415,7 @@ mod tests {
             .collect();
         let params = SegmentParams {
             threshold: Threshold::Absolute(5.0),
-            min_segment_s: 0.0,
+            min_segment_s: 0.2,
             ..SegmentParams::default()
         };
         let s = segment_speed(speed, 0.1, &params).unwrap();
@@ -442,7 +442,7 @@ mod tests {
         ];
         let params = SegmentParams {
             threshold: Threshold::Absolute(5.0),
-            min_segment_s: 0.0,
+            min_segment_s: 0.2,
             ..SegmentParams::default()
         };
         let s = segment_speed(speed, 0.1, &params).unwrap();

@@ -1,0 +1,175 @@
+//! The inference layer end to end: training on corpora, the model file, and the runtime's
+//! quantized belief against the trainer's float forward pass.
+
+use std::path::PathBuf;
+
+use gesture_runtime::inference::{memberships, Belief, StepNormalizer, MAX_CLUSTERS};
+use gesture_trainer::corpus::{load_corpus, LoadOptions};
+use gesture_trainer::inference::model::InferenceModel;
+use gesture_trainer::inference::quantize::QuantizedInference;
+use gesture_trainer::inference::train::{
+    fit, memberships as float_memberships, sequences, FitConfig, Sequence,
+};
+use gesture_trainer::synth::{generate, write_take, write_truth, SynthParams};
+
+fn zeroeggs() -> Option<PathBuf> {
+    let d =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/zeroeggs-067-speech2");
+    d.is_dir().then_some(d)
+}
+
+/// Runs the runtime's fixed-memory path (normalizer is already applied in the features) and
+/// returns the L1 distance to the float beliefs at every step.
+fn l1_per_step(model: &InferenceModel, seq: &Sequence) -> Vec<f64> {
+    let q = QuantizedInference::new(&model.gmm, &model.crf);
+    let w = q.weights().expect("dimensions within capacities");
+    let float = model.crf.beliefs(&float_memberships(&model.gmm, seq));
+    let mut belief = Belief::new();
+    let mut m = [0.0f32; MAX_CLUSTERS];
+    seq.features
+        .iter()
+        .zip(&float)
+        .map(|(f, fb)| {
+            memberships(&q.gmm, f, &mut m);
+            belief.step(&w, &m);
+            belief
+                .probs(model.states())
+                .iter()
+                .zip(fb)
+                .map(|(a, b)| (*a as f64 - b).abs())
+                .sum::<f64>()
+        })
+        .collect()
+}
+
+#[test]
+fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
+    let Some(dir) = zeroeggs() else {
+        eprintln!("skipping: ../shared/data is absent, nothing measured");
+        return;
+    };
+    let corpus = load_corpus(&[dir], &LoadOptions::default()).unwrap();
+    let (seqs, segs) = sequences(&corpus, None);
+    for states in [4usize, 12] {
+        let cfg = FitConfig {
+            states,
+            ..FitConfig::default()
+        };
+        let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
+        let l1 = l1_per_step(&model, &seqs[0]);
+        let worst = l1.iter().cloned().fold(0.0, f64::max);
+        eprintln!("S={states}: {} steps, worst L1 {worst:.2e}", l1.len());
+        assert!(l1.len() > 150);
+        assert!(worst <= 0.01, "S={states}: worst L1 {worst}");
+    }
+}
+
+#[test]
+fn features_fed_to_the_trainer_are_the_runtimes() {
+    // The aligned steps' features must equal what the runtime normalizer gives for the same
+    // steps, so training and device features cannot drift apart.
+    let dir = tempfile::tempdir().unwrap();
+    let (takes, truth) = generate(
+        &SynthParams {
+            minutes: 1.0,
+            seed: 9,
+            take_seconds: 60.0,
+        },
+        |_, _| {},
+    );
+    write_take(&takes[0], dir.path()).unwrap();
+    write_truth(&truth, dir.path()).unwrap();
+    let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
+    let t = &corpus.takes[0];
+    let mut n = StepNormalizer::new();
+    let device: Vec<_> = t.steps.iter().map(|s| (s.start_frame, n.push(s))).collect();
+    for a in &t.aligned {
+        let d = device
+            .iter()
+            .find(|(f, _)| *f == a.step.start_frame)
+            .unwrap();
+        assert_eq!(d.1, a.features);
+    }
+}
+
+#[test]
+fn model_file_round_trips_and_refuses_other_versions() {
+    let dir = tempfile::tempdir().unwrap();
+    let (takes, truth) = generate(
+        &SynthParams {
+            minutes: 2.0,
+            seed: 4,
+            take_seconds: 60.0,
+        },
+        |_, _| {},
+    );
+    for t in &takes {
+        write_take(t, dir.path()).unwrap();
+    }
+    write_truth(&truth, dir.path()).unwrap();
+    let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
+    let (seqs, segs) = sequences(&corpus, None);
+    let (model, _) = fit(
+        &seqs,
+        &segs,
+        &FitConfig {
+            states: 4,
+            ..FitConfig::default()
+        },
+        &|_| {},
+    )
+    .unwrap();
+    let path = dir.path().join("model.json");
+    model.save(&path).unwrap();
+    let back = InferenceModel::load(&path).unwrap();
+    assert_eq!(back.to_file(), model.to_file());
+    // Same beliefs after the round trip.
+    let m = float_memberships(&back.gmm, &seqs[0]);
+    assert_eq!(
+        back.crf.beliefs(&m),
+        model.crf.beliefs(&float_memberships(&model.gmm, &seqs[0]))
+    );
+    // Another version is refused with a message saying what to do.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("\"version\": 1", "\"version\": 99");
+    std::fs::write(&path, text).unwrap();
+    let err = InferenceModel::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("version 99") && err.contains("retrain"),
+        "{err}"
+    );
+    std::fs::write(&path, b"{ not json").unwrap();
+    assert!(InferenceModel::load(&path).is_err());
+}
+
+#[test]
+fn too_little_data_for_the_states_says_what_to_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let (takes, _) = generate(
+        &SynthParams {
+            minutes: 0.2,
+            seed: 4,
+            take_seconds: 60.0,
+        },
+        |_, _| {},
+    );
+    write_take(&takes[0], dir.path()).unwrap();
+    let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
+    let (seqs, segs) = sequences(&corpus, None);
+    let err = fit(
+        &seqs,
+        &segs,
+        &FitConfig {
+            states: 25,
+            ..FitConfig::default()
+        },
+        &|_| {},
+    )
+    .unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("fewer states") && msg.contains("more data"),
+        "{msg}"
+    );
+}
