@@ -173,3 +173,81 @@ fn too_little_data_for_the_states_says_what_to_change() {
         "{msg}"
     );
 }
+
+fn eval_args(train: &str, test: &str) -> gesture_trainer::cli::eval_inference::EvalArgs {
+    use clap::Parser;
+    #[derive(clap::Parser)]
+    struct W {
+        #[command(flatten)]
+        a: gesture_trainer::cli::eval_inference::EvalArgs,
+    }
+    W::parse_from(["x", "--train", train, "--test", test]).a
+}
+
+#[test]
+fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
+    let a = tempfile::tempdir().unwrap();
+    let b = tempfile::tempdir().unwrap();
+    for (dir, minutes, seed) in [(a.path(), 10.0, 101), (b.path(), 5.0, 202)] {
+        let (takes, truth) = generate(
+            &SynthParams {
+                minutes,
+                seed,
+                take_seconds: 60.0,
+            },
+            |_, _| {},
+        );
+        for t in &takes {
+            write_take(t, dir).unwrap();
+        }
+        write_truth(&truth, dir).unwrap();
+    }
+    let mut args = eval_args(a.path().to_str().unwrap(), b.path().to_str().unwrap());
+    args.states = 4;
+    let (rows, extras, ari) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
+    eprintln!("{extras}");
+    assert_eq!(rows.len(), 5);
+    for r in &rows {
+        eprintln!(
+            "W={}: crf {:.3} hmm {:.3} prior {:.3}",
+            r.window, r.crf, r.hmm, r.prior
+        );
+        assert!(
+            r.crf > r.hmm && r.crf > r.prior,
+            "window {}: {r:?}",
+            r.window
+        );
+    }
+    // The HMM's states on the training corpus against the planted ones (see the closing
+    // note of the inference issue for why this is not higher).
+    let ari = ari.expect("truth.json is next to the training corpus");
+    assert!(ari >= 0.6, "ARI {ari}");
+}
+
+#[test]
+fn fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window() {
+    let Some(dir) = zeroeggs() else {
+        eprintln!("skipping: ../shared/data is absent, nothing measured");
+        return;
+    };
+    let d = dir.to_str().unwrap();
+    let mut args = eval_args(d, d);
+    args.train_span = Some((0.0, 40.0));
+    args.test_span = Some((40.0, 50.0));
+    for states in [4usize, 8] {
+        args.states = states;
+        let (rows, extras, _) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
+        eprintln!("S={states}: {extras}");
+        for r in &rows {
+            eprintln!(
+                "  W={}: crf {:.3} hmm {:.3} prior {:.3}",
+                r.window, r.crf, r.hmm, r.prior
+            );
+            assert!(
+                r.crf > r.hmm && r.crf > r.prior,
+                "S={states} window {}: {r:?}",
+                r.window
+            );
+        }
+    }
+}

@@ -56,6 +56,9 @@ pub struct EvalArgs {
     /// Use only test steps in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub test_span: Option<(f64, f64)>,
+    /// HMM stickiness: extra self-transition pseudo-count as a fraction of steps per state.
+    #[arg(long, default_value_t = 0.0)]
+    pub stickiness: f64,
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -132,7 +135,8 @@ fn ari(
     (!found.is_empty()).then(|| adjusted_rand_index(&found, &planted))
 }
 
-pub fn run(a: &EvalArgs) -> Result<(), CliError> {
+/// The comparison and the extras line (train/test sizes, timing, ARI when known).
+pub fn evaluate(a: &EvalArgs) -> Result<(Vec<Row>, String, Option<f64>), CliError> {
     let start = Instant::now();
     let opts = a.load.options();
     let train = load_corpus(&a.train, &opts)?;
@@ -153,6 +157,7 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         restarts: a.restarts,
         seed: a.seed,
         l2: a.l2,
+        stickiness: a.stickiness,
         ..FitConfig::default()
     };
     let log = |line: &str| eprintln!("{line}");
@@ -188,9 +193,11 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         a.clusters,
         start.elapsed().as_secs_f64()
     );
+    let mut train_ari = None;
     if let Some(runs) = planted_runs(&a.train) {
         if let Some(v) = ari(&base, &train_seqs, &base.y, &runs) {
             extras += &format!("; ARI(HMM states, planted) train {v:.3}");
+            train_ari = Some(v);
         }
     }
     if let Some(runs) = planted_runs(&a.test) {
@@ -198,9 +205,19 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
             extras += &format!(", test {v:.3}");
         }
     }
+    Ok((rows, extras, train_ari))
+}
+
+pub fn run(a: &EvalArgs) -> Result<(), CliError> {
+    let (rows, extras, _) = evaluate(a)?;
     if a.json {
         eprintln!("{extras}");
-        println!("{}", serde_json::json!({ "rows": rows }));
+        // A struct, not `json!`, so the keys keep the documented order.
+        #[derive(Serialize)]
+        struct Rows<'a> {
+            rows: &'a [Row],
+        }
+        println!("{}", serde_json::to_string(&Rows { rows: &rows })?);
         return Ok(());
     }
     println!("mean log-likelihood per test step of the true kinematic parameters");

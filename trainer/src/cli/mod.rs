@@ -2,8 +2,8 @@
 //! the library. Every command prints what it did to stdout and progress to stderr; errors are
 //! one line, and the binary exits with status 2 on any error.
 
-mod eval_inference;
-mod fit;
+pub mod eval_inference;
+pub mod fit;
 mod stats;
 mod synth;
 

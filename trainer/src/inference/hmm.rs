@@ -43,6 +43,10 @@ pub struct HmmConfig {
     pub seed: u64,
     /// Steps either side averaged for the k-means initialization (0 = raw observations).
     pub init_smoothing: usize,
+    /// Extra Dirichlet pseudo-count on self-transitions, as a fraction of the steps per state
+    /// (the "sticky" HMM prior of Fox et al. 2011): hidden states that should be slow (styles)
+    /// are not spent on fast alternations (gesture phases). 0 = off.
+    pub stickiness: f64,
 }
 
 impl Default for HmmConfig {
@@ -56,6 +60,7 @@ impl Default for HmmConfig {
             pseudo_count: 1e-2,
             seed: 1,
             init_smoothing: 4,
+            stickiness: 0.0,
         }
     }
 }
@@ -239,8 +244,10 @@ impl Hmm {
         f
     }
 
-    /// Log-prior of the parameters (the priors described in the module docs).
-    pub fn log_prior(&self, pseudo_count: f64) -> f64 {
+    /// Log-prior of the parameters (the priors described in the module docs); `sticky` is the
+    /// absolute extra pseudo-count on self-transitions.
+    pub fn log_prior(&self, pseudo_count: f64, sticky: f64) -> f64 {
+        let s = self.states();
         let lp_pi: f64 = self
             .init
             .iter()
@@ -249,7 +256,11 @@ impl Hmm {
         let lp_a: f64 = self
             .trans
             .iter()
-            .map(|p| pseudo_count * p.max(1e-300).ln())
+            .enumerate()
+            .map(|(k, p)| {
+                let c = pseudo_count + if k / s == k % s { sticky } else { 0.0 };
+                c * p.max(1e-300).ln()
+            })
             .sum();
         let lp_g: f64 = self.emit.iter().map(|g| g.log_prior(self.eps)).sum();
         lp_pi + lp_a + lp_g
@@ -442,11 +453,12 @@ fn em_run(
     let mut objective = Vec::new();
     let mut last_ll = f64::NEG_INFINITY;
     let total_steps = owned.len() as f64;
+    let sticky = cfg.stickiness * total_steps / s as f64;
     for it in 0..cfg.max_iter {
         // E-step.
         let posts: Vec<Posterior> = seqs.iter().map(|q| hmm.posterior(q)).collect();
         let ll: f64 = posts.iter().map(|p| p.log_likelihood).sum();
-        let obj = ll + hmm.log_prior(cfg.pseudo_count);
+        let obj = ll + hmm.log_prior(cfg.pseudo_count, sticky);
         objective.push(obj);
         progress(restart, it, obj);
         last_ll = ll;
@@ -460,6 +472,9 @@ fn em_run(
         let a = cfg.pseudo_count;
         let mut init = vec![a; s];
         let mut trans = vec![a; s * s];
+        for i in 0..s {
+            trans[i * s + i] += sticky;
+        }
         for p in &posts {
             if let Some(g0) = p.gamma.first() {
                 for i in 0..s {

@@ -91,6 +91,8 @@ pub struct FitConfig {
     pub restarts: usize,
     /// Seed.
     pub seed: u64,
+    /// HMM stickiness (see [`HmmConfig::stickiness`]).
+    pub stickiness: f64,
     /// CRF L2 strength per training step; `None` chooses it by validation (see [`choose_l2`]).
     pub l2: Option<f64>,
     /// Front-end rate the features came from.
@@ -105,6 +107,7 @@ impl Default for FitConfig {
             window: 4,
             restarts: 4,
             seed: 1,
+            stickiness: 0.0,
             l2: None,
             sample_rate_hz: gesture_runtime::prosody::DEFAULT_RATE_HZ,
         }
@@ -236,6 +239,7 @@ pub fn fit_base(
         states: cfg.states,
         restarts: cfg.restarts,
         seed: cfg.seed,
+        stickiness: cfg.stickiness,
         ..HmmConfig::default()
     };
     let (hmm, runs) = Hmm::fit(&y, &hcfg, |r, it, obj| {

@@ -64,15 +64,15 @@ pub fn styles() -> [Style; 4] {
             syllable_s: 0.24,
             phrase_len: (4, 8),
             pause_s: 0.5,
-            elevation: -40.0,
+            elevation: -30.0,
             swing: 25.0,
             flexion: 30.0,
             spread: 4.0,
             stroke_s: 1.1,
             reach: 20.0,
             bow: 4.0,
-            hold_prob: 0.05,
-            hold_s: 0.35,
+            hold_prob: 1.0,
+            hold_s: 0.5,
             two_handed: true,
         },
         Style {
@@ -87,11 +87,11 @@ pub fn styles() -> [Style; 4] {
             swing: 45.0,
             flexion: 30.0,
             spread: 5.0,
-            stroke_s: 0.25,
+            stroke_s: 0.35,
             reach: 10.0,
             bow: 2.0,
-            hold_prob: 0.05,
-            hold_s: 0.25,
+            hold_prob: 1.0,
+            hold_s: 0.3,
             two_handed: true,
         },
         Style {
@@ -109,8 +109,8 @@ pub fn styles() -> [Style; 4] {
             stroke_s: 0.8,
             reach: 22.0,
             bow: 30.0,
-            hold_prob: 0.05,
-            hold_s: 0.3,
+            hold_prob: 1.0,
+            hold_s: 0.4,
             two_handed: true,
         },
         Style {
@@ -125,11 +125,11 @@ pub fn styles() -> [Style; 4] {
             swing: 8.0,
             flexion: 20.0,
             spread: 3.0,
-            stroke_s: 1.5,
+            stroke_s: 0.8,
             reach: 2.0,
             bow: 3.0,
-            hold_prob: 0.5,
-            hold_s: 0.8,
+            hold_prob: 1.0,
+            hold_s: 1.0,
             two_handed: false,
         },
     ]
@@ -146,7 +146,7 @@ pub struct StateRun {
     pub state: usize,
 }
 
-/// Piecewise-constant state over a take: runs of 5-12 s, each followed by a different state
+/// Piecewise-constant state over a take: runs of 8-16 s, each followed by a different state
 /// chosen uniformly (a semi-Markov chain).
 #[derive(Clone, Debug, Serialize)]
 pub struct StateTrack {
@@ -161,7 +161,7 @@ impl StateTrack {
         let mut t = 0.0;
         let mut state = rng.random_range(0..n_states);
         while t < duration_s {
-            let len = rng.random_range(5.0..12.0);
+            let len = rng.random_range(8.0..16.0);
             let end = (t + len).min(duration_s);
             runs.push(StateRun {
                 start_s: t,
