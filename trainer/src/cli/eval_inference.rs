@@ -62,6 +62,7 @@ pub struct EvalArgs {
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Corpus loading options.
     #[command(flatten)]
     pub load: CorpusArgs,
 }
@@ -208,6 +209,7 @@ pub fn evaluate(a: &EvalArgs) -> Result<(Vec<Row>, String, Option<f64>), CliErro
     Ok((rows, extras, train_ari))
 }
 
+/// Runs the command.
 pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     let (rows, extras, _) = evaluate(a)?;
     if a.json {

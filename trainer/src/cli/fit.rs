@@ -38,6 +38,7 @@ pub struct FitArgs {
     /// Output model file.
     #[arg(long)]
     pub out: PathBuf,
+    /// Corpus loading options.
     #[command(flatten)]
     pub load: CorpusArgs,
 }
@@ -63,6 +64,7 @@ pub fn parse_span(s: &str) -> Result<(f64, f64), String> {
     Ok((a, b))
 }
 
+/// Runs the command.
 pub fn run(a: &FitArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let corpus = load_corpus(&a.corpus, &a.load.options())?;

@@ -23,6 +23,7 @@ pub struct StatsArgs {
     /// Print one JSON object instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Corpus loading options.
     #[command(flatten)]
     pub corpus: CorpusArgs,
 }
@@ -150,6 +151,7 @@ fn opt(v: Option<f64>, prec: usize) -> String {
     v.map_or_else(|| "-".into(), |x| format!("{x:.prec$}"))
 }
 
+/// Runs the command.
 pub fn run(a: &StatsArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let takes = discover(&a.inputs)?;

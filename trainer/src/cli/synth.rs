@@ -23,6 +23,7 @@ pub struct SynthArgs {
     pub out: PathBuf,
 }
 
+/// Runs the command.
 pub fn run(a: &SynthArgs) -> Result<(), CliError> {
     if !(a.minutes.is_finite() && a.minutes > 0.0 && a.minutes <= 600.0) {
         return Err(format!("--minutes must be between 0 and 600, not {}", a.minutes).into());
