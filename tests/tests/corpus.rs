@@ -4,23 +4,17 @@
 use std::path::Path;
 
 use gesture_trainer::corpus::{load_corpus, CorpusError, LoadOptions};
-use gesture_trainer::synth::{generate, write_take, write_truth, SynthParams};
+use gesture_trainer::synth::{write_corpus, SynthParams};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 
 fn synth_corpus(dir: &Path, minutes: f64, seed: u64) {
-    let (takes, truth) = generate(
-        &SynthParams {
-            minutes,
-            seed,
-            take_seconds: 60.0,
-        },
-        |_, _| {},
-    );
-    for t in &takes {
-        write_take(t, dir).unwrap();
-    }
-    write_truth(&truth, dir).unwrap();
+    let params = SynthParams {
+        minutes,
+        seed,
+        take_seconds: 60.0,
+    };
+    write_corpus(&params, dir, |_, _| {}).unwrap();
 }
 
 fn pearson(xy: &[(f64, f64)]) -> f64 {

@@ -10,7 +10,7 @@ use gesture_trainer::inference::quantize::QuantizedInference;
 use gesture_trainer::inference::train::{
     fit, memberships as float_memberships, sequences, FitConfig, Sequence,
 };
-use gesture_trainer::synth::{generate, write_take, write_truth, SynthParams};
+use gesture_trainer::synth::{write_corpus, SynthParams};
 
 fn zeroeggs() -> Option<PathBuf> {
     let d =
@@ -69,16 +69,13 @@ fn features_fed_to_the_trainer_are_the_runtimes() {
     // The aligned steps' features must equal what the runtime normalizer gives for the same
     // steps, so training and device features cannot drift apart.
     let dir = tempfile::tempdir().unwrap();
-    let (takes, truth) = generate(
-        &SynthParams {
-            minutes: 1.0,
-            seed: 9,
-            take_seconds: 60.0,
-        },
-        |_, _| {},
-    );
-    write_take(&takes[0], dir.path()).unwrap();
-    write_truth(&truth, dir.path()).unwrap();
+    let params = SynthParams {
+        minutes: 1.0,
+        seed: 9,
+        take_seconds: 60.0,
+    };
+    write_corpus(&params, dir.path(), |_, _| {}).unwrap();
+
     let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
     let t = &corpus.takes[0];
     let mut n = StepNormalizer::new();
@@ -95,18 +92,12 @@ fn features_fed_to_the_trainer_are_the_runtimes() {
 #[test]
 fn model_file_round_trips_and_refuses_other_versions() {
     let dir = tempfile::tempdir().unwrap();
-    let (takes, truth) = generate(
-        &SynthParams {
-            minutes: 2.0,
-            seed: 4,
-            take_seconds: 60.0,
-        },
-        |_, _| {},
-    );
-    for t in &takes {
-        write_take(t, dir.path()).unwrap();
-    }
-    write_truth(&truth, dir.path()).unwrap();
+    let params = SynthParams {
+        minutes: 2.0,
+        seed: 4,
+        take_seconds: 60.0,
+    };
+    write_corpus(&params, dir.path(), |_, _| {}).unwrap();
     let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
     let (seqs, segs) = sequences(&corpus, None);
     let (model, _) = fit(
@@ -146,15 +137,12 @@ fn model_file_round_trips_and_refuses_other_versions() {
 #[test]
 fn too_little_data_for_the_states_says_what_to_change() {
     let dir = tempfile::tempdir().unwrap();
-    let (takes, _) = generate(
-        &SynthParams {
-            minutes: 0.2,
-            seed: 4,
-            take_seconds: 60.0,
-        },
-        |_, _| {},
-    );
-    write_take(&takes[0], dir.path()).unwrap();
+    let params = SynthParams {
+        minutes: 0.2,
+        seed: 4,
+        take_seconds: 60.0,
+    };
+    write_corpus(&params, dir.path(), |_, _| {}).unwrap();
     let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
     let (seqs, segs) = sequences(&corpus, None);
     let err = fit(
@@ -189,21 +177,15 @@ fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
     let a = tempfile::tempdir().unwrap();
     let b = tempfile::tempdir().unwrap();
     for (dir, minutes, seed) in [(a.path(), 10.0, 101), (b.path(), 5.0, 202)] {
-        let (takes, truth) = generate(
-            &SynthParams {
-                minutes,
-                seed,
-                take_seconds: 60.0,
-            },
-            |_, _| {},
-        );
-        for t in &takes {
-            write_take(t, dir).unwrap();
-        }
-        write_truth(&truth, dir).unwrap();
+        let params = SynthParams {
+            minutes,
+            seed,
+            take_seconds: 60.0,
+        };
+        write_corpus(&params, dir, |_, _| {}).unwrap();
     }
     let mut args = eval_args(a.path().to_str().unwrap(), b.path().to_str().unwrap());
-    args.states = 4;
+    args.model.states = 4;
     let (rows, extras, ari) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
     eprintln!("{extras}");
     assert_eq!(rows.len(), 5);
@@ -235,7 +217,7 @@ fn fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window() {
     args.train_span = Some((0.0, 40.0));
     args.test_span = Some((40.0, 50.0));
     for states in [4usize, 8] {
-        args.states = states;
+        args.model.states = states;
         let (rows, extras, _) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
         eprintln!("S={states}: {extras}");
         for r in &rows {

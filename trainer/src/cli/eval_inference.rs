@@ -13,14 +13,12 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::fit::parse_span;
-use super::{CliError, CorpusArgs};
+use super::{CliError, CorpusArgs, ModelArgs};
 use crate::corpus::load_corpus;
 use crate::inference::eval::{
     adjusted_rand_index, crf_beliefs, mean_score, prior_beliefs, RemappedHmm,
 };
-use crate::inference::train::{
-    fit_base, fit_crf, normalized, sequences, FitConfig, FitReport, Sequence,
-};
+use crate::inference::train::{fit_base, fit_crf, normalized, sequences, FitReport, Sequence};
 
 /// Arguments of `eval-inference`.
 #[derive(Debug, clap::Args)]
@@ -34,34 +32,18 @@ pub struct EvalArgs {
     /// CRF windows to compare.
     #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2, 3, 4, 5])]
     pub windows: Vec<usize>,
-    /// Hidden states S.
-    #[arg(long, default_value_t = 12)]
-    pub states: usize,
-    /// Prosody clusters K.
-    #[arg(long, default_value_t = 8)]
-    pub clusters: usize,
-    /// HMM restarts.
-    #[arg(long, default_value_t = 4)]
-    pub restarts: usize,
-    /// Seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// CRF L2 regularization per training step (default: chosen by validation on the last
-    /// 20% of each training take).
-    #[arg(long)]
-    pub l2: Option<f64>,
     /// Use only training steps in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub train_span: Option<(f64, f64)>,
     /// Use only test steps in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub test_span: Option<(f64, f64)>,
-    /// HMM stickiness: extra self-transition pseudo-count as a fraction of steps per state.
-    #[arg(long, default_value_t = 0.0)]
-    pub stickiness: f64,
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Model options.
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Corpus loading options.
     #[command(flatten)]
     pub load: CorpusArgs,
@@ -152,15 +134,7 @@ pub fn evaluate(a: &EvalArgs) -> Result<(Vec<Row>, String, Option<f64>), CliErro
     if test_steps == 0 {
         return Err("the test set has no time steps (check --test and --test-span)".into());
     }
-    let cfg = FitConfig {
-        states: a.states,
-        clusters: a.clusters,
-        restarts: a.restarts,
-        seed: a.seed,
-        l2: a.l2,
-        stickiness: a.stickiness,
-        ..FitConfig::default()
-    };
+    let cfg = a.model.config(a.windows.first().copied().unwrap_or(4));
     let log = |line: &str| eprintln!("{line}");
     let mut report = FitReport::default();
     let base = fit_base(&train_seqs, &segs, &cfg, &mut report, &log)?;
@@ -190,8 +164,8 @@ pub fn evaluate(a: &EvalArgs) -> Result<(Vec<Row>, String, Option<f64>), CliErro
     let train_steps: usize = train_seqs.iter().map(Sequence::len).sum();
     let mut extras = format!(
         "train {train_steps} steps, test {test_steps} steps, S={} K={}; {:.2} s",
-        a.states,
-        a.clusters,
+        a.model.states,
+        a.model.clusters,
         start.elapsed().as_secs_f64()
     );
     let mut train_ari = None;

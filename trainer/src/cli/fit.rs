@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{CliError, CorpusArgs};
+use super::{CliError, CorpusArgs, ModelArgs};
 use crate::corpus::load_corpus;
-use crate::inference::train::{fit, sequences, FitConfig};
+use crate::inference::train::{fit, sequences};
 
 /// Arguments of `fit`.
 #[derive(Debug, clap::Args)]
@@ -13,31 +13,18 @@ pub struct FitArgs {
     /// Training corpus: BVH+WAV files or folders.
     #[arg(long, required = true, num_args = 1..)]
     pub corpus: Vec<PathBuf>,
-    /// Hidden states S.
-    #[arg(long, default_value_t = 12)]
-    pub states: usize,
-    /// Prosody clusters K.
-    #[arg(long, default_value_t = 8)]
-    pub clusters: usize,
     /// CRF input window W (syllables, causal).
     #[arg(long, default_value_t = 4)]
     pub window: usize,
-    /// HMM restarts (run in parallel).
-    #[arg(long, default_value_t = 4)]
-    pub restarts: usize,
-    /// Seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// CRF L2 regularization per training step (default: chosen by validation on the last
-    /// 20% of each training take).
-    #[arg(long)]
-    pub l2: Option<f64>,
     /// Use only steps whose midpoint is in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub span: Option<(f64, f64)>,
     /// Output model file.
     #[arg(long)]
     pub out: PathBuf,
+    /// Model options.
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Corpus loading options.
     #[command(flatten)]
     pub load: CorpusArgs,
@@ -76,15 +63,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         segs.len(),
         corpus.load_s
     );
-    let cfg = FitConfig {
-        states: a.states,
-        clusters: a.clusters,
-        window: a.window,
-        restarts: a.restarts,
-        seed: a.seed,
-        l2: a.l2,
-        ..FitConfig::default()
-    };
+    let cfg = a.model.config(a.window);
     let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;
     model.save(&a.out)?;
     println!(

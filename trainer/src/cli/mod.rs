@@ -56,6 +56,46 @@ impl CorpusArgs {
     }
 }
 
+/// Model options shared by `fit` and `eval-inference`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ModelArgs {
+    /// Hidden states S.
+    #[arg(long, default_value_t = 12)]
+    pub states: usize,
+    /// Prosody clusters K.
+    #[arg(long, default_value_t = 8)]
+    pub clusters: usize,
+    /// HMM restarts (run in parallel).
+    #[arg(long, default_value_t = 4)]
+    pub restarts: usize,
+    /// Seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// CRF L2 regularization per training step (default: chosen by validation on the last
+    /// 20% of each training take).
+    #[arg(long)]
+    pub l2: Option<f64>,
+    /// HMM stickiness: extra self-transition pseudo-count as a fraction of steps per state.
+    #[arg(long, default_value_t = 0.0)]
+    pub stickiness: f64,
+}
+
+impl ModelArgs {
+    /// The fit settings for CRF window `window`.
+    pub fn config(&self, window: usize) -> crate::inference::train::FitConfig {
+        crate::inference::train::FitConfig {
+            states: self.states,
+            clusters: self.clusters,
+            window,
+            restarts: self.restarts,
+            seed: self.seed,
+            stickiness: self.stickiness,
+            l2: self.l2,
+            ..Default::default()
+        }
+    }
+}
+
 /// An error of any command, printed as one line.
 pub type CliError = Box<dyn std::error::Error + Send + Sync>;
 

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::{ensure_dir, progress_bar, CliError};
-use crate::synth::{generate_take, speaker_for, write_take, write_truth, SynthParams, Truth};
+use crate::synth::{write_corpus, SynthParams};
 
 /// Arguments of `synth`.
 #[derive(Debug, clap::Args)]
@@ -42,38 +42,21 @@ pub fn run(a: &SynthArgs) -> Result<(), CliError> {
         seed: a.seed,
         take_seconds: a.take_seconds,
     };
-    let total = params.minutes * 60.0;
-    let n = (total / params.take_seconds).ceil().max(1.0) as usize;
-    let speaker = speaker_for(params.seed);
-    let pb = progress_bar(n as u64, "synth");
-    let mut truths = Vec::with_capacity(n);
-    let (mut syllables, mut segments) = (0usize, 0usize);
-    for i in 0..n {
-        let dur = (total - i as f64 * params.take_seconds)
-            .min(params.take_seconds)
-            .max(1.0);
-        let take = generate_take(params.seed, i, dur, &speaker);
-        write_take(&take, &a.out)?;
-        syllables += take.truth.syllables.len();
-        segments += take.truth.segments.len();
-        truths.push(take.truth);
-        pb.inc(1);
-    }
+    let pb = progress_bar(1, "synth");
+    let w = write_corpus(&params, &a.out, |done, total| {
+        pb.set_length(total as u64);
+        pb.set_position(done as u64);
+    })?;
     pb.finish_and_clear();
-    let truth = Truth {
-        format: "gesture-synth-truth/1",
-        seed: params.seed,
-        speaker,
-        states: crate::synth::styles::styles().to_vec(),
-        takes: truths,
-    };
-    write_truth(&truth, &a.out)?;
     println!(
-        "wrote {n} takes ({:.1} min) to {}: {syllables} planted syllables, {segments} gesture segments, \
+        "wrote {} takes ({:.1} min) to {}: {} planted syllables, {} gesture segments, \
          {} states; truth in {} ({:.1} s)",
-        total / 60.0,
+        w.takes,
+        a.minutes,
         a.out.display(),
-        truth.states.len(),
+        w.syllables,
+        w.segments,
+        w.truth.states.len(),
         a.out.join("truth.json").display(),
         start.elapsed().as_secs_f64()
     );

@@ -120,28 +120,82 @@ pub fn speaker_for(seed: u64) -> speech::Speaker {
     speech::Speaker::draw(&mut rng)
 }
 
+/// What [`write_corpus`] wrote.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// Takes written.
+    pub takes: usize,
+    /// Planted syllables.
+    pub syllables: usize,
+    /// Planted gesture segments.
+    pub segments: usize,
+    /// The truth (also in `truth.json`).
+    pub truth: Truth,
+}
+
+/// Generates and writes a corpus take by take (so memory stays at one take), then
+/// `truth.json`; calls `progress(done, total)` after each take.
+pub fn write_corpus(
+    params: &SynthParams,
+    dir: &Path,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Written, WriteError> {
+    let (mut takes, mut syllables, mut segments) = (0, 0, 0);
+    let truth = for_each_take(params, |take, done, total| {
+        write_take(&take, dir)?;
+        takes += 1;
+        syllables += take.truth.syllables.len();
+        segments += take.truth.segments.len();
+        progress(done, total);
+        Ok(())
+    })?;
+    write_truth(&truth, dir)?;
+    Ok(Written {
+        takes,
+        syllables,
+        segments,
+        truth,
+    })
+}
+
 /// Generates a whole corpus in memory, takes in order, calling `progress` after each.
 pub fn generate(
     params: &SynthParams,
     mut progress: impl FnMut(usize, usize),
 ) -> (Vec<Take>, Truth) {
+    let mut takes = Vec::new();
+    let truth = for_each_take(params, |take, done, total| {
+        takes.push(take);
+        progress(done, total);
+        Ok::<_, std::convert::Infallible>(())
+    })
+    .unwrap_or_else(|e| match e {});
+    (takes, truth)
+}
+
+/// Generates the takes of `params` one after the other, handing each to `visit`, and
+/// returns the corpus truth.
+fn for_each_take<E>(
+    params: &SynthParams,
+    mut visit: impl FnMut(Take, usize, usize) -> Result<(), E>,
+) -> Result<Truth, E> {
     let total = (params.minutes * 60.0).max(0.0);
     let n = (total / params.take_seconds).ceil().max(1.0) as usize;
     let speaker = speaker_for(params.seed);
-    let mut takes = Vec::with_capacity(n);
+    let mut truths = Vec::with_capacity(n);
     for i in 0..n {
         let dur = (total - i as f64 * params.take_seconds).min(params.take_seconds);
-        takes.push(generate_take(params.seed, i, dur.max(1.0), &speaker));
-        progress(i + 1, n);
+        let take = generate_take(params.seed, i, dur.max(1.0), &speaker);
+        truths.push(take.truth.clone());
+        visit(take, i + 1, n)?;
     }
-    let truth = Truth {
+    Ok(Truth {
         format: "gesture-synth-truth/1",
         seed: params.seed,
         speaker,
         states: styles::styles().to_vec(),
-        takes: takes.iter().map(|t| t.truth.clone()).collect(),
-    };
-    (takes, truth)
+        takes: truths,
+    })
 }
 
 /// Seed for take `index` of a corpus seeded with `seed`: takes are independent streams, so a
