@@ -63,10 +63,10 @@ pub struct ModelArgs {
     #[arg(long, default_value_t = 12)]
     pub states: usize,
     /// Prosody clusters K.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 12)]
     pub clusters: usize,
-    /// HMM restarts (run in parallel).
-    #[arg(long, default_value_t = 4)]
+    /// HMM restarts (run in parallel; EM finds better optima with more).
+    #[arg(long, default_value_t = 16)]
     pub restarts: usize,
     /// Seed.
     #[arg(long, default_value_t = 1)]

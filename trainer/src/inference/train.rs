@@ -103,9 +103,9 @@ impl Default for FitConfig {
     fn default() -> Self {
         Self {
             states: 12,
-            clusters: 8,
+            clusters: 12,
             window: 4,
-            restarts: 4,
+            restarts: 16,
             seed: 1,
             stickiness: 0.0,
             l2: None,
@@ -314,7 +314,7 @@ pub fn fit_base(
 }
 
 /// Candidate L2 strengths (per step) tried by [`choose_l2`].
-pub const L2_GRID: [f64; 6] = [1e-3, 3e-3, 1e-2, 3e-2, 0.1, 0.3];
+pub const L2_GRID: [f64; 4] = [1e-3, 1e-2, 0.1, 0.3];
 
 fn split_seq(q: &TrainSeq, cut: usize) -> (TrainSeq, TrainSeq) {
     let cut = cut.clamp(1, q.memberships.len().saturating_sub(1).max(1));

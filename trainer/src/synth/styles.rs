@@ -72,7 +72,7 @@ pub fn styles() -> [Style; 4] {
             reach: 20.0,
             bow: 4.0,
             hold_prob: 1.0,
-            hold_s: 0.5,
+            hold_s: 0.6,
             two_handed: true,
         },
         Style {
@@ -91,7 +91,7 @@ pub fn styles() -> [Style; 4] {
             reach: 10.0,
             bow: 2.0,
             hold_prob: 1.0,
-            hold_s: 0.3,
+            hold_s: 0.6,
             two_handed: true,
         },
         Style {
@@ -110,7 +110,7 @@ pub fn styles() -> [Style; 4] {
             reach: 22.0,
             bow: 30.0,
             hold_prob: 1.0,
-            hold_s: 0.4,
+            hold_s: 0.6,
             two_handed: true,
         },
         Style {
