@@ -17,6 +17,7 @@
 
 pub mod audio;
 pub mod cli;
+pub mod control;
 pub mod corpus;
 pub mod features;
 pub mod inference;

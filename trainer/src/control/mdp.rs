@@ -1,0 +1,296 @@
+//! The control MDP and value iteration (DESIGN.md "MDP" and "It factorizes; store it that
+//! way"; the paper's section 7 and appendix).
+//!
+//! Decisions happen at exit points. At exit point `e` of segment `a`, in hidden state `s`, the
+//! controller either continues `a` (interruption exits only; costs nothing) or enters a
+//! segment `c` at its first frame, paying `psi_c(s) + S(e, c)`. Between decisions the state
+//! evolves without observations as `P^n`, `P` the row-normalized CRF transition matrix and `n`
+//! the number of steps the played frames span (their duration over the mean step duration).
+//! With discount `gamma` per decision:
+//!
+//! ```text
+//! U(c, s)      = psi_c(s) + gamma * sum_s' P^n(c)(s, s') Q(first_exit(c), s')
+//! U_cont(e, s) = gamma * sum_s' P^m(e)(s, s') Q(next_exit(e), s')
+//! Q(e, s)      = min( U_cont(e, s) [interruption exits], min_c S(e, c) + U(c, s) )
+//! ```
+//!
+//! The source exit enters the value of a candidate only through `S(e, c)`, so the full
+//! `V(c, e, s) = S(e, c) + U(c, s)` never needs to be stored: `U` (segments x states),
+//! `U_cont` (exit points x states) and the successor costs suffice. [`unfactorized_q`]
+//! computes the recursion without this sharing and the tests check both agree. At run time,
+//! with belief `b`, the choice is `argmin_c S(e, c) + b . U(c)` against `b . U_cont(e)`.
+
+use rayon::prelude::*;
+
+use super::library::Library;
+
+/// Settings of the MDP.
+#[derive(Clone, Copy, Debug)]
+pub struct MdpParams {
+    /// Discount per decision.
+    pub discount: f64,
+    /// Mean duration of one inference step (syllable or pause), seconds.
+    pub step_s: f64,
+    /// Iteration cap.
+    pub max_iter: usize,
+    /// Stop when no value changes by more than this.
+    pub tol: f64,
+}
+
+impl Default for MdpParams {
+    fn default() -> Self {
+        Self {
+            discount: 0.9,
+            step_s: 0.3,
+            max_iter: 1000,
+            tol: 1e-7,
+        }
+    }
+}
+
+/// Row-normalized CRF transition matrix: `P[i][j] ~ exp(trans[i, j])`.
+pub fn transition_matrix(trans: &[f64], states: usize) -> Vec<Vec<f64>> {
+    (0..states)
+        .map(|i| {
+            let row = &trans[i * states..(i + 1) * states];
+            let m = row.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let e: Vec<f64> = row.iter().map(|v| (v - m).exp()).collect();
+            let z: f64 = e.iter().sum();
+            e.iter().map(|v| v / z).collect()
+        })
+        .collect()
+}
+
+/// `P^0 ..= P^max` by repeated multiplication.
+pub fn powers(p: &[Vec<f64>], max: usize) -> Vec<Vec<Vec<f64>>> {
+    let s = p.len();
+    let mut out = vec![(0..s)
+        .map(|i| (0..s).map(|j| (i == j) as u8 as f64).collect())
+        .collect::<Vec<Vec<f64>>>()];
+    for k in 1..=max {
+        let prev = &out[k - 1];
+        let next = (0..s)
+            .map(|i| {
+                (0..s)
+                    .map(|j| (0..s).map(|m| prev[i][m] * p[m][j]).sum())
+                    .collect()
+            })
+            .collect();
+        out.push(next);
+    }
+    out
+}
+
+/// The solved MDP in factorized form.
+#[derive(Clone, Debug)]
+pub struct Policy {
+    /// States.
+    pub states: usize,
+    /// `U[c][s]`.
+    pub u: Vec<Vec<f64>>,
+    /// `U_cont[e][s]` (`None` at end exits).
+    pub u_cont: Vec<Option<Vec<f64>>>,
+    /// `S(e, c)`.
+    pub succ: Vec<Vec<f64>>,
+    /// `Q[e][s]`.
+    pub q: Vec<Vec<f64>>,
+    /// Value-iteration sweeps.
+    pub iterations: usize,
+    /// Largest change in the last sweep.
+    pub residual: f64,
+}
+
+/// What the controller does at an exit point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Action {
+    /// Keep playing the current segment (interruption exits).
+    Continue,
+    /// Enter segment `c` at its first frame.
+    Enter(usize),
+}
+
+/// Steps spanned by `frames` frames.
+pub fn steps_for(frames: usize, fps: f64, p: &MdpParams) -> usize {
+    ((frames as f64 / fps) / p.step_s).round() as usize
+}
+
+/// Steps from entering segment `c` to its first exit, and from exit `e` to the next exit.
+pub fn step_counts(lib: &Library, p: &MdpParams) -> (Vec<usize>, Vec<Option<usize>>) {
+    let enter = (0..lib.segments.len())
+        .map(|c| steps_for(lib.exits[lib.first_exit[c]].frame + 1, lib.fps, p))
+        .collect();
+    let cont = (0..lib.exits.len())
+        .map(|e| {
+            lib.next_exit(e)
+                .map(|n| steps_for(lib.exits[n].frame - lib.exits[e].frame, lib.fps, p))
+        })
+        .collect();
+    (enter, cont)
+}
+
+fn propagate(pn: &[Vec<f64>], q: &[f64]) -> Vec<f64> {
+    pn.iter()
+        .map(|row| row.iter().zip(q).map(|(a, b)| a * b).sum())
+        .collect()
+}
+
+/// Value iteration. `psi[c][s]`, `succ[e][c]`, `p` the per-step state transition matrix.
+pub fn solve(
+    lib: &Library,
+    psi: &[Vec<f64>],
+    succ: Vec<Vec<f64>>,
+    p: &[Vec<f64>],
+    params: &MdpParams,
+) -> Policy {
+    let s = p.len();
+    let (enter, cont) = step_counts(lib, params);
+    let max_n = enter
+        .iter()
+        .chain(cont.iter().flatten())
+        .copied()
+        .max()
+        .unwrap_or(0);
+    let pw = powers(p, max_n);
+    let n_seg = lib.segments.len();
+    let n_exit = lib.exits.len();
+    let mut q = vec![vec![0.0; s]; n_exit];
+    let mut u = vec![vec![0.0; s]; n_seg];
+    let mut u_cont: Vec<Option<Vec<f64>>> = vec![None; n_exit];
+    let mut iterations = 0;
+    let mut residual = f64::INFINITY;
+    while iterations < params.max_iter && residual > params.tol {
+        u = (0..n_seg)
+            .into_par_iter()
+            .map(|c| {
+                let fut = propagate(&pw[enter[c]], &q[lib.first_exit[c]]);
+                (0..s)
+                    .map(|k| psi[c][k] + params.discount * fut[k])
+                    .collect()
+            })
+            .collect();
+        u_cont = (0..n_exit)
+            .into_par_iter()
+            .map(|e| {
+                cont[e].map(|m| {
+                    let fut = propagate(&pw[m], &q[e + 1]);
+                    fut.iter().map(|v| params.discount * v).collect()
+                })
+            })
+            .collect();
+        let new_q: Vec<Vec<f64>> = (0..n_exit)
+            .into_par_iter()
+            .map(|e| {
+                let mut best: Vec<f64> =
+                    u_cont[e].clone().unwrap_or_else(|| vec![f64::INFINITY; s]);
+                for (c, uc) in u.iter().enumerate() {
+                    let sc = succ[e][c];
+                    for k in 0..s {
+                        let v = sc + uc[k];
+                        if v < best[k] {
+                            best[k] = v;
+                        }
+                    }
+                }
+                best
+            })
+            .collect();
+        residual = new_q
+            .iter()
+            .zip(&q)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+            .fold(0.0, f64::max);
+        q = new_q;
+        iterations += 1;
+    }
+    Policy {
+        states: s,
+        u,
+        u_cont,
+        succ,
+        q,
+        iterations,
+        residual,
+    }
+}
+
+impl Policy {
+    /// Expected cost of `action` at exit `e` under belief `b`.
+    pub fn cost(&self, e: usize, action: Action, b: &[f64]) -> f64 {
+        match action {
+            Action::Continue => match &self.u_cont[e] {
+                Some(uc) => b.iter().zip(uc).map(|(x, y)| x * y).sum(),
+                None => f64::INFINITY,
+            },
+            Action::Enter(c) => {
+                self.succ[e][c] + b.iter().zip(&self.u[c]).map(|(x, y)| x * y).sum::<f64>()
+            }
+        }
+    }
+
+    /// The best action at exit `e` under belief `b` among `candidates` (and continuing,
+    /// where allowed). Ties go to continuing, then to the lowest segment index.
+    pub fn decide(
+        &self,
+        e: usize,
+        b: &[f64],
+        candidates: impl IntoIterator<Item = usize>,
+    ) -> Action {
+        let mut best = (self.cost(e, Action::Continue, b), Action::Continue);
+        for c in candidates {
+            let v = self.cost(e, Action::Enter(c), b);
+            if v < best.0 {
+                best = (v, Action::Enter(c));
+            }
+        }
+        best.1
+    }
+}
+
+/// The same recursion without the factorization: `V(c, e, s)` evaluated in full for every
+/// exit, candidate and state (for the tests; `O(E N S)` memory per sweep).
+pub fn unfactorized_q(
+    lib: &Library,
+    psi: &[Vec<f64>],
+    succ: &[Vec<f64>],
+    p: &[Vec<f64>],
+    params: &MdpParams,
+    sweeps: usize,
+) -> Vec<Vec<f64>> {
+    let s = p.len();
+    let (enter, cont) = step_counts(lib, params);
+    let max_n = enter
+        .iter()
+        .chain(cont.iter().flatten())
+        .copied()
+        .max()
+        .unwrap_or(0);
+    let pw = powers(p, max_n);
+    let mut q = vec![vec![0.0; s]; lib.exits.len()];
+    for _ in 0..sweeps {
+        let mut v = vec![vec![vec![0.0; s]; lib.segments.len()]; lib.exits.len()];
+        for e in 0..lib.exits.len() {
+            for c in 0..lib.segments.len() {
+                for k in 0..s {
+                    let fut: f64 = (0..s)
+                        .map(|j| pw[enter[c]][k][j] * q[lib.first_exit[c]][j])
+                        .sum();
+                    v[e][c][k] = succ[e][c] + psi[c][k] + params.discount * fut;
+                }
+            }
+        }
+        let mut next = vec![vec![f64::INFINITY; s]; lib.exits.len()];
+        for e in 0..lib.exits.len() {
+            for k in 0..s {
+                if let Some(m) = cont[e] {
+                    let fut: f64 = (0..s).map(|j| pw[m][k][j] * q[e + 1][j]).sum();
+                    next[e][k] = params.discount * fut;
+                }
+                for c in 0..lib.segments.len() {
+                    next[e][k] = next[e][k].min(v[e][c][k]);
+                }
+            }
+        }
+        q = next;
+    }
+    q
+}

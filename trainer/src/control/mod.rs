@@ -1,0 +1,177 @@
+//! The control layer (DESIGN.md "Control layer", the paper's section 7 and appendix): from a
+//! belief over hidden states, which gesture segment to show next.
+//!
+//! - [`library`]: segments, recorded order, exit points, pose features;
+//! - [`costs`]: `psi` (segment fit per state) and successor costs;
+//! - [`mdp`]: belief propagation between decisions, value iteration, the factorized tables
+//!   and the decision rule;
+//! - [`prune`]: dropping successors that are never optimal, and budget truncation;
+//! - [`dp`]: the offline dynamic-programming reference.
+
+// Index loops mirror the recursion's subscripts and are kept on purpose.
+#![allow(clippy::needless_range_loop)]
+
+pub mod costs;
+pub mod dp;
+pub mod library;
+pub mod mdp;
+pub mod prune;
+
+pub use library::{ExitPoint, LibSegment, Library};
+pub use mdp::{Action, MdpParams, Policy};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::{analyze, EffectorSpec, Normalization, SegmentParams};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn small_library(seconds: f64) -> Library {
+        let speaker = crate::synth::speaker_for(5);
+        let take = crate::synth::generate_take(5, 0, seconds, &speaker);
+        let motion = take.motion();
+        let analysis =
+            analyze(&motion, &EffectorSpec::default(), &SegmentParams::default()).unwrap();
+        let norm = Normalization::fit(&analysis.y_raw).unwrap();
+        Library::from_takes(
+            vec![library::LibTake {
+                source: "synthetic".into(),
+                motion,
+                analysis,
+            }],
+            &norm,
+            3,
+        )
+        .unwrap()
+    }
+
+    fn random_problem(
+        lib: &Library,
+        s: usize,
+        seed: u64,
+    ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<Vec<f64>>) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let psi: Vec<Vec<f64>> = (0..lib.segments.len())
+            .map(|_| (0..s).map(|_| rng.random_range(0.5..3.0)).collect())
+            .collect();
+        let sig = costs::Signatures::new(lib);
+        let succ = costs::successor_costs(lib, &sig, &costs::CostParams::default());
+        let p: Vec<Vec<f64>> = (0..s)
+            .map(|i| {
+                let mut row: Vec<f64> = (0..s)
+                    .map(|j| {
+                        if i == j {
+                            5.0
+                        } else {
+                            rng.random_range(0.1..1.0)
+                        }
+                    })
+                    .collect();
+                let z: f64 = row.iter().sum();
+                row.iter_mut().for_each(|v| *v /= z);
+                row
+            })
+            .collect();
+        (psi, succ, p)
+    }
+
+    #[test]
+    fn factorized_tables_equal_the_unfactorized_recursion() {
+        let lib = small_library(20.0);
+        assert!(lib.segments.len() >= 5, "{} segments", lib.segments.len());
+        let (psi, succ, p) = random_problem(&lib, 3, 1);
+        for sweeps in [1usize, 2, 5, 12] {
+            let params = MdpParams {
+                max_iter: sweeps,
+                tol: 0.0,
+                ..MdpParams::default()
+            };
+            let fact = mdp::solve(&lib, &psi, succ.clone(), &p, &params);
+            let full = mdp::unfactorized_q(&lib, &psi, &succ, &p, &params, sweeps);
+            for (a, b) in fact.q.iter().zip(&full) {
+                for (x, y) in a.iter().zip(b) {
+                    assert!(
+                        (x - y).abs() < 1e-9 * (1.0 + y.abs()),
+                        "{sweeps} sweeps: {x} vs {y}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn value_iteration_converges_and_recorded_order_is_cheap() {
+        let lib = small_library(30.0);
+        let (psi, succ, p) = random_problem(&lib, 4, 2);
+        let pol = mdp::solve(&lib, &psi, succ, &p, &MdpParams::default());
+        assert!(pol.residual <= 1e-7, "residual {}", pol.residual);
+        // Leaving a segment at its end for its recorded successor costs nothing.
+        for (e, ex) in lib.exits.iter().enumerate() {
+            if ex.end {
+                if let Some(n) = lib.segments[ex.segment].next {
+                    if lib.segments[n].prev.is_some() {
+                        assert_eq!(pol.succ[e][n], 0.0);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pruning_never_changes_a_decision() {
+        let lib = small_library(40.0);
+        let (psi, succ, p) = random_problem(&lib, 5, 3);
+        let pol = mdp::solve(&lib, &psi, succ, &p, &MdpParams::default());
+        let kept = prune::prune(&pol);
+        let total: usize = lib.exits.len() * lib.segments.len();
+        let left: usize = kept.iter().map(Vec::len).sum();
+        assert!(left < total);
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..2000 {
+            let e = rng.random_range(0..lib.exits.len());
+            let mut b: Vec<f64> = (0..5).map(|_| rng.random::<f64>().powi(3)).collect();
+            let z: f64 = b.iter().sum();
+            b.iter_mut().for_each(|v| *v /= z);
+            let full = pol.decide(e, &b, 0..lib.segments.len());
+            let pruned = pol.decide(e, &b, kept[e].iter().copied());
+            assert_eq!(pol.cost(e, full, &b), pol.cost(e, pruned, &b), "exit {e}");
+        }
+    }
+
+    #[test]
+    fn offline_dp_is_no_worse_than_following_the_policy() {
+        let lib = small_library(20.0);
+        let (psi, succ, p) = random_problem(&lib, 3, 5);
+        let pol = mdp::solve(&lib, &psi, succ, &p, &MdpParams::default());
+        let post = |t: usize| {
+            let k = (t / 60) % 3;
+            (0..3)
+                .map(|i| if i == k { 0.8 } else { 0.1 })
+                .collect::<Vec<f64>>()
+        };
+        let frames = 300;
+        let start = lib.exits.len() - 1;
+        let (dp_cost, plan) = dp::best_sequence(&lib, &pol, &psi, frames, start, &post);
+        assert!(!plan.is_empty());
+        // Greedy online play with the same beliefs, same cost accounting.
+        let (mut t, mut e, mut greedy) = (0usize, start, 0.0);
+        while t <= frames {
+            let b = post(t.min(frames - 1));
+            match pol.decide(e, &b, 0..lib.segments.len()) {
+                Action::Continue => {
+                    let n = lib.next_exit(e).unwrap();
+                    t += (lib.exits[n].frame - lib.exits[e].frame).max(1);
+                    e = n;
+                }
+                Action::Enter(c) => {
+                    greedy +=
+                        b.iter().zip(&psi[c]).map(|(x, y)| x * y).sum::<f64>() + pol.succ[e][c];
+                    t += lib.exits[lib.first_exit[c]].frame + 1;
+                    e = lib.first_exit[c];
+                }
+            }
+        }
+        assert!(dp_cost <= greedy + 1e-9, "dp {dp_cost} > online {greedy}");
+    }
+}
