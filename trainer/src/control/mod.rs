@@ -46,11 +46,10 @@ mod tests {
         .unwrap()
     }
 
-    fn random_problem(
-        lib: &Library,
-        s: usize,
-        seed: u64,
-    ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    /// `(psi, successor costs, transition matrix)`.
+    type Problem = (Vec<Vec<f64>>, Vec<Vec<f64>>, Vec<Vec<f64>>);
+
+    fn random_problem(lib: &Library, s: usize, seed: u64) -> Problem {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let psi: Vec<Vec<f64>> = (0..lib.segments.len())
             .map(|_| (0..s).map(|_| rng.random_range(0.5..3.0)).collect())
