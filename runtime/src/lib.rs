@@ -23,9 +23,12 @@
 //!   and pause steps during silence.
 //! - [`inference`]: speaker-normalized step features, prosody-cluster memberships and the CRF
 //!   forward step: the belief over hidden gesture-style states.
+//! - [`rig`]: servo calibration and the `ServoRig`: pose angles to clamped, slew-limited PWM
+//!   duty cycles through `embedded_hal::pwm::SetDutyCycle`; neutral pose on fault.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod inference;
 pub mod prosody;
+pub mod rig;
