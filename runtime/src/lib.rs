@@ -23,12 +23,19 @@
 //!   and pause steps during silence.
 //! - [`inference`]: speaker-normalized step features, prosody-cluster memberships and the CRF
 //!   forward step: the belief over hidden gesture-style states.
+//! - [`policy`]: the choice of the next segment at an exit point from the belief.
+//! - [`player`]: segment playback as rig poses with a short blend at cuts.
+//! - [`controller`]: samples in, poses out: front-end, belief, decisions and playback on one
+//!   sample clock.
 //! - [`rig`]: servo calibration and the `ServoRig`: pose angles to clamped, slew-limited PWM
 //!   duty cycles through `embedded_hal::pwm::SetDutyCycle`; neutral pose on fault.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod controller;
 pub mod inference;
+pub mod player;
+pub mod policy;
 pub mod prosody;
 pub mod rig;

@@ -1,0 +1,227 @@
+//! The `Controller`: microphone samples in; at every animation tick a pose out; decisions at
+//! exit points from the current belief (DESIGN.md "The runtime").
+//!
+//! Per sample the prosody front-end runs; each finished step (syllable or pause) is
+//! normalized, turned into cluster memberships and fed to the CRF forward step. Animation ticks
+//! come at the library's frame rate, placed on the sample clock (tick `k` is due once
+//! `ceil(k * rate / fps)` samples have arrived), and input is split at tick boundaries, so
+//! the result does not depend on how samples are chunked. At a tick the player outputs the
+//! current frame of the current segment; if that frame is the current exit point, the policy
+//! decides with the belief as it stands.
+//!
+//! Memory is fixed: the front-end (about 9 KiB), a belief, the player and a few counters.
+//! Nothing allocates or panics; poses are finite.
+
+use crate::inference::{
+    memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
+};
+use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
+use crate::policy::{select, Choice, Decision, PolicyTables};
+use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
+
+/// What the controller reports, in time order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ControllerEvent<'a> {
+    /// A prosody frame.
+    Frame(Frame),
+    /// A step and the belief after it.
+    Step {
+        /// The step.
+        step: Step,
+        /// Belief over states after the step.
+        belief: &'a [f32],
+    },
+    /// A decision at an exit point.
+    Decision {
+        /// Animation tick of the decision.
+        tick: u64,
+        /// The decision.
+        decision: Decision,
+    },
+    /// The pose of an animation tick (one value per rig channel, degrees).
+    Pose {
+        /// Tick number from 0.
+        tick: u64,
+        /// Channel values.
+        pose: &'a [f32],
+    },
+}
+
+/// Why a controller could not be built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControllerError {
+    /// The front-end settings are invalid.
+    FrontEnd(ConfigError),
+    /// The blob's dimensions disagree (GMM clusters vs CRF, states vs policy, channels).
+    Dimensions,
+}
+
+impl core::fmt::Display for ControllerError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::FrontEnd(e) => write!(f, "front-end: {e}"),
+            Self::Dimensions => {
+                f.write_str("inconsistent dimensions between inference, policy and library")
+            }
+        }
+    }
+}
+
+impl core::error::Error for ControllerError {}
+
+/// The whole on-device controller over validated tables `T` (policy) and `L` (library).
+pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
+    tables: &'a T,
+    lib: &'a L,
+    crf: CrfWeights<'a>,
+    gmm: [GmmComponent; MAX_CLUSTERS],
+    clusters: usize,
+    front_end: FrontEnd,
+    normalizer: StepNormalizer,
+    belief: Belief,
+    uniform: [f32; MAX_STATES],
+    player: Player,
+    exit: usize,
+    pose: [f32; MAX_CHANNELS],
+    rate: u64,
+    fps_milli: u64,
+    samples: u64,
+    ticks: u64,
+}
+
+impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
+    /// A controller at the start of segment 0 with a uniform belief.
+    pub fn new(
+        config: &ProsodyConfig,
+        gmm: &[GmmComponent],
+        crf: CrfWeights<'a>,
+        tables: &'a T,
+        lib: &'a L,
+    ) -> Result<Self, ControllerError> {
+        let front_end = FrontEnd::new(config).map_err(ControllerError::FrontEnd)?;
+        let s = tables.states();
+        let fps = lib.fps();
+        if gmm.len() != crf.clusters
+            || gmm.len() > MAX_CLUSTERS
+            || s != crf.states
+            || s == 0
+            || tables.exit_count() == 0
+            || lib.segment_count() == 0
+            || lib.channels() > MAX_CHANNELS
+            || !(fps.is_finite() && fps > 0.0 && fps <= 1000.0)
+        {
+            return Err(ControllerError::Dimensions);
+        }
+        let mut comps = [GmmComponent::default(); MAX_CLUSTERS];
+        comps[..gmm.len()].copy_from_slice(gmm);
+        let mut uniform = [0.0; MAX_STATES];
+        uniform[..s].iter_mut().for_each(|v| *v = 1.0 / s as f32);
+        Ok(Self {
+            tables,
+            lib,
+            crf,
+            gmm: comps,
+            clusters: gmm.len(),
+            front_end,
+            normalizer: StepNormalizer::new(),
+            belief: Belief::new(),
+            uniform,
+            player: Player::new(),
+            exit: tables.first_exit(0),
+            pose: [0.0; MAX_CHANNELS],
+            rate: config.sample_rate_hz as u64,
+            fps_milli: libm::roundf(fps * 1000.0) as u64,
+            samples: 0,
+            ticks: 0,
+        })
+    }
+
+    /// The current belief (uniform before the first step).
+    pub fn belief(&self) -> &[f32] {
+        let s = self.tables.states();
+        if self.belief.steps() == 0 {
+            &self.uniform[..s]
+        } else {
+            self.belief.probs(s)
+        }
+    }
+
+    /// Samples needed before tick `k` is due.
+    fn due(&self, k: u64) -> u64 {
+        // ceil(k * rate / fps) with fps in thousandths.
+        (k * self.rate * 1000).div_ceil(self.fps_milli.max(1))
+    }
+
+    /// Feeds samples; reports frames, steps with beliefs, decisions and poses through `sink`.
+    pub fn push(&mut self, samples: &[i16], sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        let mut rest = samples;
+        while !rest.is_empty() {
+            let due = self.due(self.ticks);
+            if self.samples >= due {
+                self.tick(sink);
+                continue;
+            }
+            let n = ((due - self.samples) as usize).min(rest.len());
+            let (now, later) = rest.split_at(n);
+            self.feed(now, sink);
+            rest = later;
+        }
+        if self.samples >= self.due(self.ticks) {
+            self.tick(sink);
+        }
+    }
+
+    fn feed(&mut self, samples: &[i16], sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        let (normalizer, belief, gmm, clusters, crf, states) = (
+            &mut self.normalizer,
+            &mut self.belief,
+            &self.gmm,
+            self.clusters,
+            &self.crf,
+            self.tables.states(),
+        );
+        self.front_end.push(samples, &mut |ev| match ev {
+            Event::Frame(f) => sink(ControllerEvent::Frame(f)),
+            Event::Step(step) => {
+                let x = normalizer.push(&step);
+                let mut m = [0.0f32; MAX_CLUSTERS];
+                memberships(&gmm[..clusters], &x, &mut m);
+                belief.step(crf, &m);
+                sink(ControllerEvent::Step {
+                    step,
+                    belief: belief.probs(states),
+                });
+            }
+        });
+        self.samples += samples.len() as u64;
+    }
+
+    fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        let played = self.player.frame();
+        self.player.tick(self.lib, &mut self.pose);
+        let tick = self.ticks;
+        self.ticks += 1;
+        sink(ControllerEvent::Pose {
+            tick,
+            pose: &self.pose[..self.lib.channels().min(MAX_CHANNELS)],
+        });
+        let e = self.exit;
+        if self.tables.exit_segment(e) == self.player.segment()
+            && played >= self.tables.exit_frame(e)
+        {
+            let decision = select(self.tables, e, self.belief());
+            match decision.choice {
+                Choice::Continue => {
+                    if e + 1 < self.tables.exit_count() {
+                        self.exit = e + 1;
+                    }
+                }
+                Choice::Enter(c) => {
+                    self.player.enter(c);
+                    self.exit = self.tables.first_exit(c);
+                }
+            }
+            sink(ControllerEvent::Decision { tick, decision });
+        }
+    }
+}

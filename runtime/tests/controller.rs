@@ -1,0 +1,240 @@
+//! The Controller over small in-memory tables: chunking invariance, decisions exactly at exit
+//! frames, finite poses, a blend at cuts, garbage audio never breaking it.
+
+use gesture_runtime::controller::{Controller, ControllerEvent};
+use gesture_runtime::inference::{CrfWeights, GmmComponent, I16Table};
+use gesture_runtime::player::LibraryFrames;
+use gesture_runtime::policy::{Choice, PolicyTables};
+use gesture_runtime::prosody::ProsodyConfig;
+
+/// Three segments of 20, 12 and 30 frames; exits at interruption frames and ends.
+struct Tables {
+    exits: Vec<(usize, usize, bool)>,
+    first: Vec<usize>,
+    u: Vec<[f32; 2]>,
+    u_cont: Vec<[f32; 2]>,
+    succ: Vec<Vec<(usize, f32)>>,
+}
+
+impl PolicyTables for Tables {
+    fn states(&self) -> usize {
+        2
+    }
+    fn exit_count(&self) -> usize {
+        self.exits.len()
+    }
+    fn exit_segment(&self, e: usize) -> usize {
+        self.exits[e].0
+    }
+    fn exit_frame(&self, e: usize) -> usize {
+        self.exits[e].1
+    }
+    fn exit_is_end(&self, e: usize) -> bool {
+        self.exits[e].2
+    }
+    fn first_exit(&self, c: usize) -> usize {
+        self.first[c]
+    }
+    fn u(&self, c: usize, s: usize) -> f32 {
+        self.u[c][s]
+    }
+    fn u_cont(&self, e: usize, s: usize) -> f32 {
+        self.u_cont[e][s]
+    }
+    fn successor_count(&self, e: usize) -> usize {
+        self.succ[e].len()
+    }
+    fn successor(&self, e: usize, k: usize) -> (usize, f32) {
+        self.succ[e][k]
+    }
+}
+
+struct Lib {
+    lens: [usize; 3],
+}
+
+impl LibraryFrames for Lib {
+    fn channels(&self) -> usize {
+        2
+    }
+    fn fps(&self) -> f32 {
+        30.0
+    }
+    fn segment_count(&self) -> usize {
+        3
+    }
+    fn segment_len(&self, c: usize) -> usize {
+        self.lens[c]
+    }
+    fn value(&self, c: usize, f: usize, ch: usize) -> f32 {
+        (c * 100 + f) as f32 + 1000.0 * ch as f32
+    }
+}
+
+fn tables() -> Tables {
+    let exits = vec![
+        (0, 9, false),
+        (0, 19, true),
+        (1, 11, true),
+        (2, 14, false),
+        (2, 29, true),
+    ];
+    let all: Vec<(usize, f32)> = vec![(0, 0.5), (1, 0.2), (2, 0.4)];
+    Tables {
+        first: vec![0, 2, 3],
+        u: vec![[1.0, 3.0], [2.0, 1.0], [1.5, 1.5]],
+        u_cont: vec![[1.6, 1.6], [0.0, 0.0], [0.0, 0.0], [0.5, 5.0], [0.0, 0.0]],
+        succ: vec![all.clone(), all.clone(), all.clone(), all.clone(), all],
+        exits,
+    }
+}
+
+fn gmm() -> [GmmComponent; 2] {
+    let c = |m: f32| GmmComponent {
+        log_voiced: -1.0,
+        log_unvoiced: -1.0,
+        mean: [m, -1.2],
+        inv_chol: [1.0, 0.0, 1.0],
+        log_norm: -1.8,
+        coef: [0.0, 0.0, 0.0],
+        inv_sd: 2.0,
+        log_norm_f0: -0.2,
+    };
+    [c(-0.5), c(0.5)]
+}
+
+fn speech(seconds: f32) -> Vec<i16> {
+    let n = (seconds * 16000.0) as usize;
+    let mut ph = 0.0f32;
+    (0..n)
+        .map(|i| {
+            let t = i as f32 / 16000.0;
+            ph += 2.0 * std::f32::consts::PI * (120.0 + 30.0 * (t * 0.9).sin()) / 16000.0;
+            let env = (2.0 * std::f32::consts::PI * 3.5 * t).sin().max(0.0)
+                * if t % 2.0 < 1.6 { 1.0 } else { 0.0 };
+            (env * 9000.0 * (ph.sin() + 0.4 * (2.0 * ph).sin())) as i16
+        })
+        .collect()
+}
+
+#[derive(Debug, PartialEq)]
+enum Rec {
+    Decision(u64, usize, Choice),
+    Pose(u64, Vec<f32>),
+    Step(u32, Vec<f32>),
+}
+
+fn run(audio: &[i16], chunk: usize) -> Vec<Rec> {
+    let t = tables();
+    let lib = Lib { lens: [20, 12, 30] };
+    let crf_bytes_init = [0u8; 4];
+    let mut trans = Vec::new();
+    for v in [400i16, -400, -400, 400] {
+        trans.extend_from_slice(&v.to_le_bytes());
+    }
+    let mut obs = Vec::new();
+    for v in [800i16, -800, -800, 800] {
+        obs.extend_from_slice(&v.to_le_bytes());
+    }
+    let crf = CrfWeights::new(
+        2,
+        2,
+        1,
+        I16Table::new(&crf_bytes_init, 1e-3, 2).unwrap(),
+        I16Table::new(&trans, 1e-3, 4).unwrap(),
+        I16Table::new(&obs, 1e-3, 4).unwrap(),
+    )
+    .unwrap();
+    let g = gmm();
+    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &lib).unwrap();
+    let mut out = Vec::new();
+    let mut sink = |e: ControllerEvent<'_>| match e {
+        ControllerEvent::Decision { tick, decision } => {
+            out.push(Rec::Decision(tick, decision.exit, decision.choice))
+        }
+        ControllerEvent::Pose { tick, pose } => out.push(Rec::Pose(tick, pose.to_vec())),
+        ControllerEvent::Step { step, belief } => {
+            out.push(Rec::Step(step.end_frame, belief.to_vec()))
+        }
+        ControllerEvent::Frame(_) => {}
+    };
+    for ch in audio.chunks(chunk.max(1)) {
+        c.push(ch, &mut sink);
+    }
+    out
+}
+
+#[test]
+fn chunking_does_not_change_decisions_or_poses() {
+    let audio = speech(6.0);
+    let whole = run(&audio, audio.len());
+    assert!(
+        whole
+            .iter()
+            .filter(|r| matches!(r, Rec::Decision(..)))
+            .count()
+            > 5
+    );
+    for chunk in [1usize, 7, 160, 533, 4096] {
+        assert_eq!(run(&audio, chunk), whole, "chunk {chunk}");
+    }
+}
+
+#[test]
+fn one_pose_per_tick_and_decisions_at_exit_frames() {
+    let audio = speech(4.0);
+    let recs = run(&audio, 1000);
+    let poses: Vec<&Vec<f32>> = recs
+        .iter()
+        .filter_map(|r| {
+            if let Rec::Pose(_, p) = r {
+                Some(p)
+            } else {
+                None
+            }
+        })
+        .collect();
+    // 4 s at 30 fps: ticks 0..=120 (tick k is due after ceil(k * 16000 / 30) samples).
+    assert_eq!(poses.len(), 121);
+    assert!(poses
+        .iter()
+        .all(|p| p.len() == 2 && p.iter().all(|v| v.is_finite())));
+    // The first decision is at exit 0 (frame 9 of segment 0): after the pose of tick 9.
+    let first = recs.iter().find_map(|r| {
+        if let Rec::Decision(t, e, _) = r {
+            Some((*t, *e))
+        } else {
+            None
+        }
+    });
+    assert_eq!(first, Some((9, 0)));
+    // Poses follow the library frames (channel 0 = segment * 100 + frame) except while blending.
+    if let Rec::Pose(_, p) = &recs.iter().find(|r| matches!(r, Rec::Pose(0, _))).unwrap() {
+        assert_eq!(p[0], 0.0);
+    }
+}
+
+#[test]
+fn garbage_audio_keeps_producing_valid_poses() {
+    let mut x = 12345u32;
+    let audio: Vec<i16> = (0..48_000)
+        .map(|i| {
+            x = x.wrapping_mul(1664525).wrapping_add(1013904223);
+            match (i / 8000) % 3 {
+                0 => (x >> 16) as i16,
+                1 => i16::MIN,
+                _ => 0,
+            }
+        })
+        .collect();
+    for r in run(&audio, 777) {
+        match r {
+            Rec::Pose(_, p) => assert!(p.iter().all(|v| v.is_finite())),
+            Rec::Step(_, b) => {
+                let s: f32 = b.iter().sum();
+                assert!((s - 1.0).abs() < 1e-4 && b.iter().all(|v| v.is_finite()));
+            }
+            Rec::Decision(_, e, _) => assert!(e < 5),
+        }
+    }
+}
