@@ -6,11 +6,13 @@
 //! - [`mdp`]: belief propagation between decisions, value iteration, the factorized tables
 //!   and the decision rule;
 //! - [`prune`]: dropping successors that are never optimal, and budget truncation;
-//! - [`dp`]: the offline dynamic-programming reference.
+//! - [`dp`]: the offline dynamic-programming reference;
+//! - [`build`]: model + library to a solved, pruned, quantized policy and its regret.
 
 // Index loops mirror the recursion's subscripts and are kept on purpose.
 #![allow(clippy::needless_range_loop)]
 
+pub mod build;
 pub mod costs;
 pub mod dp;
 pub mod library;
