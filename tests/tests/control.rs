@@ -49,7 +49,7 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
     };
     // Model and library from the ZeroEGGS take.
     let ze = d.join("zeroeggs-067-speech2");
-    let corpus = load_corpus(&[ze.clone()], &LoadOptions::default()).unwrap();
+    let corpus = load_corpus(std::slice::from_ref(&ze), &LoadOptions::default()).unwrap();
     let (seqs, segs) = sequences(&corpus, None);
     let (model, _) = fit(&seqs, &segs, &FitConfig::default(), &|_| {}).unwrap();
     let lib = Library::from_files(
