@@ -23,6 +23,8 @@
 //!   and pause steps during silence.
 //! - [`inference`]: speaker-normalized step features, prosody-cluster memberships and the CRF
 //!   forward step: the belief over hidden gesture-style states.
+//! - [`blob`]: the policy blob (header, CRC-32, postcard payload), validated once at load into
+//!   a typed error; accessors are infallible afterwards.
 //! - [`policy`]: the choice of the next segment at an exit point from the belief.
 //! - [`player`]: segment playback as rig poses with a short blend at cuts.
 //! - [`controller`]: samples in, poses out: front-end, belief, decisions and playback on one
@@ -33,6 +35,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod blob;
 pub mod controller;
 pub mod inference;
 pub mod player;

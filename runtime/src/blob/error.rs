@@ -1,0 +1,516 @@
+//! Why a blob was refused: one `Copy` variant per rule, grouped by the phase that checks it
+//! (header, payload decoding, then each section's fields).
+
+use core::fmt;
+
+use crate::prosody::ConfigError;
+use crate::rig::CalError;
+
+/// A section of the payload.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Section {
+    /// Front-end settings.
+    FrontEnd,
+    /// GMM and CRF.
+    Inference,
+    /// Value tables and successors.
+    Policy,
+    /// Gesture segments and frames.
+    Library,
+    /// Output channels.
+    Rig,
+}
+
+impl Section {
+    /// The section's name in docs/blob-format.md.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::FrontEnd => "front_end",
+            Self::Inference => "inference",
+            Self::Policy => "policy",
+            Self::Library => "library",
+            Self::Rig => "rig",
+        }
+    }
+}
+
+impl fmt::Display for Section {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A field of the payload, as named in docs/blob-format.md.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Field {
+    /// `inference.states`.
+    States,
+    /// `inference.clusters`.
+    Clusters,
+    /// `inference.window`.
+    Window,
+    /// `inference.gmm`.
+    Gmm,
+    /// `inference.crf_init`.
+    CrfInit,
+    /// `inference.crf_trans`.
+    CrfTrans,
+    /// `inference.crf_obs`.
+    CrfObs,
+    /// `policy.segments`.
+    Segments,
+    /// `policy.exit_points`.
+    ExitPoints,
+    /// `policy.u`.
+    U,
+    /// `policy.u_cont`.
+    UCont,
+    /// `policy.exits`.
+    Exits,
+    /// `policy.succ_offsets`.
+    SuccOffsets,
+    /// `policy.succ` (and `policy.succ_cost_scale`).
+    Succ,
+    /// `library.channels`.
+    Channels,
+    /// `library.frames`.
+    Frames,
+    /// `library.seg_start`.
+    SegStart,
+    /// `library.seg_len`.
+    SegLen,
+    /// `library.frame_scales`.
+    FrameScales,
+    /// `library.frame_values`.
+    FrameValues,
+    /// `library.strokes`.
+    Strokes,
+    /// `library.labels`.
+    Labels,
+    /// `rig.calibration`.
+    Calibration,
+}
+
+impl Field {
+    /// `section.field`, as in docs/blob-format.md.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::States => "inference.states",
+            Self::Clusters => "inference.clusters",
+            Self::Window => "inference.window",
+            Self::Gmm => "inference.gmm",
+            Self::CrfInit => "inference.crf_init",
+            Self::CrfTrans => "inference.crf_trans",
+            Self::CrfObs => "inference.crf_obs",
+            Self::Segments => "policy.segments",
+            Self::ExitPoints => "policy.exit_points",
+            Self::U => "policy.u",
+            Self::UCont => "policy.u_cont",
+            Self::Exits => "policy.exits",
+            Self::SuccOffsets => "policy.succ_offsets",
+            Self::Succ => "policy.succ",
+            Self::Channels => "library.channels",
+            Self::Frames => "library.frames",
+            Self::SegStart => "library.seg_start",
+            Self::SegLen => "library.seg_len",
+            Self::FrameScales => "library.frame_scales",
+            Self::FrameValues => "library.frame_values",
+            Self::Strokes => "library.strokes",
+            Self::Labels => "library.labels",
+            Self::Calibration => "rig.calibration",
+        }
+    }
+}
+
+impl fmt::Display for Field {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Why [`Blob::parse`](super::Blob::parse) refused the bytes. Checks run in the order of the
+/// variants below (docs/blob-format.md, "Validation"), and the first failure is reported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlobError {
+    // --- header ---
+    /// Fewer bytes than the 16-byte header.
+    BlobTooShort {
+        /// Bytes given.
+        len: usize,
+    },
+    /// The first four bytes are not `GSTB`.
+    BadMagic,
+    /// A format version this runtime does not read.
+    UnsupportedVersion {
+        /// Version in the header.
+        found: u16,
+    },
+    /// Header flags this runtime does not know (version 1 defines none).
+    UnsupportedFlags {
+        /// Flags in the header.
+        found: u16,
+    },
+    /// The header promises more payload than the bytes hold.
+    Truncated {
+        /// Payload length in the header.
+        declared: u32,
+        /// Bytes after the header.
+        available: usize,
+    },
+    /// Bytes follow the declared payload.
+    TrailingBytes {
+        /// Payload length in the header.
+        declared: u32,
+        /// Bytes after the header.
+        available: usize,
+    },
+    /// The payload's CRC-32 differs from the header's.
+    BadCrc {
+        /// CRC in the header.
+        stored: u32,
+        /// CRC of the payload bytes.
+        computed: u32,
+    },
+    // --- payload decoding ---
+    /// A section does not decode as postcard (or bytes follow the last section).
+    Malformed {
+        /// The first section that failed.
+        section: Section,
+    },
+    // --- front_end ---
+    /// The front-end settings are refused by the front-end.
+    FrontEnd(ConfigError),
+    // --- dimensions ---
+    /// A count that must be at least 1 is 0.
+    ZeroCount {
+        /// Which count.
+        field: Field,
+    },
+    /// More hidden states than [`MAX_STATES`](crate::inference::MAX_STATES).
+    StateCountTooLarge {
+        /// States in the blob.
+        found: u32,
+    },
+    /// More clusters than [`MAX_CLUSTERS`](crate::inference::MAX_CLUSTERS).
+    ClusterCountTooLarge {
+        /// Clusters in the blob.
+        found: u32,
+    },
+    /// A longer window than [`MAX_WINDOW`](crate::inference::MAX_WINDOW).
+    WindowTooLarge {
+        /// Window in the blob.
+        found: u32,
+    },
+    /// More segments than [`MAX_SEGMENTS`](super::MAX_SEGMENTS).
+    TooManySegments {
+        /// Segments in the blob.
+        found: u32,
+    },
+    /// More exit points than [`MAX_EXITS`](super::MAX_EXITS).
+    TooManyExits {
+        /// Exit points in the blob.
+        found: u32,
+    },
+    /// More channels than [`MAX_CHANNELS`](super::MAX_CHANNELS).
+    TooManyChannels {
+        /// Channels in the blob.
+        found: u32,
+    },
+    /// More frames than [`MAX_FRAMES`](super::MAX_FRAMES).
+    TooManyFrames {
+        /// Frames in the blob.
+        found: u32,
+    },
+    /// The policy's state count differs from the inference layer's.
+    StateCountMismatch {
+        /// `inference.states`.
+        inference: u32,
+        /// `policy.states`.
+        policy: u32,
+    },
+    /// The policy's segment count differs from the library's.
+    SegmentCountMismatch {
+        /// `library.segments`.
+        library: u32,
+        /// `policy.segments`.
+        policy: u32,
+    },
+    // --- tables ---
+    /// A table's byte length does not match its dimensions.
+    TableLength {
+        /// The table.
+        field: Field,
+        /// Bytes its dimensions require.
+        expected: usize,
+        /// Bytes it has.
+        found: usize,
+    },
+    /// A scale, offset or `f32` value of a table is NaN or infinite.
+    NotFinite {
+        /// The table.
+        field: Field,
+    },
+    // --- library ---
+    /// `library.fps` is not finite or outside `(0, MAX_FPS]`.
+    BadFrameRate,
+    /// A segment has length 0.
+    EmptySegment {
+        /// Segment index.
+        segment: u32,
+    },
+    /// A segment's frames run past the frame table.
+    SegmentOutOfFrames {
+        /// Segment index.
+        segment: u32,
+    },
+    /// A stroke frame is not within its segment.
+    StrokeOutOfRange {
+        /// Segment index.
+        segment: u32,
+    },
+    // --- rig ---
+    /// `rig.period_us` is not finite, not above the longest pulse or above
+    /// [`PERIOD_MAX_US`](crate::rig::PERIOD_MAX_US).
+    BadPwmPeriod,
+    /// A channel's calibration fails [`ChannelCal::validate`](crate::rig::ChannelCal::validate).
+    BadCalibration {
+        /// Channel index.
+        channel: u32,
+        /// What is wrong with it.
+        error: CalError,
+    },
+    /// `rig.channel_names` does not hold one name per channel.
+    ChannelNameCount {
+        /// Channels.
+        expected: u32,
+        /// Names.
+        found: u32,
+    },
+    // --- policy ---
+    /// `policy.discount` is not in `[0, 1]`.
+    BadDiscount,
+    /// An exit point names a segment that does not exist.
+    ExitSegmentOutOfRange {
+        /// Exit index.
+        exit: u32,
+        /// Its segment.
+        segment: u32,
+    },
+    /// An exit point's frame is not within its segment.
+    ExitFrameOutOfRange {
+        /// Exit index.
+        exit: u32,
+        /// Its frame.
+        frame: u32,
+    },
+    /// Exit points are not strictly increasing by (segment, frame).
+    ExitsNotSorted {
+        /// First exit out of order.
+        exit: u32,
+    },
+    /// A segment has no exit point at its last frame.
+    MissingEndExit {
+        /// Segment index.
+        segment: u32,
+    },
+    /// `succ_offsets` does not start at 0 or decreases.
+    SuccessorOffsetsNotMonotone {
+        /// Exit index whose offset is wrong.
+        exit: u32,
+    },
+    /// A successor names a segment that does not exist.
+    SuccessorSegmentOutOfRange {
+        /// Entry index.
+        entry: u32,
+        /// Its segment.
+        segment: u32,
+    },
+    /// An exit point's successors are not strictly increasing by segment.
+    SuccessorsNotSorted {
+        /// Exit index.
+        exit: u32,
+    },
+    /// An exit at its segment's last frame has no successor (playback could not go on).
+    NoSuccessors {
+        /// Exit index.
+        exit: u32,
+    },
+}
+
+impl fmt::Display for BlobError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use super::{FORMAT_VERSION, HEADER_LEN};
+        match *self {
+            Self::BlobTooShort { len } => write!(
+                f,
+                "blob too short: {len} bytes, the header alone is {HEADER_LEN} (not a policy blob?)"
+            ),
+            Self::BadMagic => f.write_str("bad magic: not a policy blob (expected `GSTB`)"),
+            Self::UnsupportedVersion { found } => write!(
+                f,
+                "unsupported blob format version {found}: this runtime reads version \
+                 {FORMAT_VERSION} (repack with a matching gesture-train)"
+            ),
+            Self::UnsupportedFlags { found } => write!(
+                f,
+                "unsupported header flags {found:#06x}: this runtime knows none \
+                 (repack with a matching gesture-train)"
+            ),
+            Self::Truncated {
+                declared,
+                available,
+            } => write!(
+                f,
+                "truncated blob: header declares {declared} payload bytes, only {available} \
+                 follow (incomplete copy or flash write?)"
+            ),
+            Self::TrailingBytes {
+                declared,
+                available,
+            } => write!(
+                f,
+                "trailing bytes: header declares {declared} payload bytes, {available} follow \
+                 (pass exactly the blob's bytes)"
+            ),
+            Self::BadCrc { stored, computed } => write!(
+                f,
+                "payload CRC-32 mismatch: header {stored:#010x}, payload {computed:#010x} \
+                 (corrupted blob: copy or flash it again)"
+            ),
+            Self::Malformed { section } => write!(
+                f,
+                "malformed payload: section `{section}` does not decode (written by another \
+                 format revision? repack it)"
+            ),
+            Self::FrontEnd(e) => write!(f, "front_end: {e}"),
+            Self::ZeroCount { field } => write!(f, "{field} is 0 (must be at least 1)"),
+            Self::StateCountTooLarge { found } => write!(
+                f,
+                "{found} hidden states, the runtime holds at most {} (train with fewer states)",
+                crate::inference::MAX_STATES
+            ),
+            Self::ClusterCountTooLarge { found } => write!(
+                f,
+                "{found} prosody clusters, the runtime holds at most {} (train with fewer)",
+                crate::inference::MAX_CLUSTERS
+            ),
+            Self::WindowTooLarge { found } => write!(
+                f,
+                "CRF window {found}, the runtime holds at most {} (train a shorter window)",
+                crate::inference::MAX_WINDOW
+            ),
+            Self::TooManySegments { found } => write!(
+                f,
+                "{found} segments, the runtime holds at most {} (use a smaller library)",
+                super::MAX_SEGMENTS
+            ),
+            Self::TooManyExits { found } => write!(
+                f,
+                "{found} exit points, the runtime holds at most {} (fewer interruption frames \
+                 or a smaller library)",
+                super::MAX_EXITS
+            ),
+            Self::TooManyChannels { found } => write!(
+                f,
+                "{found} channels, the runtime drives at most {} (use a smaller rig)",
+                super::MAX_CHANNELS
+            ),
+            Self::TooManyFrames { found } => write!(
+                f,
+                "{found} library frames, the runtime holds at most {} (use a smaller library)",
+                super::MAX_FRAMES
+            ),
+            Self::StateCountMismatch { inference, policy } => write!(
+                f,
+                "policy has {policy} states but the inference layer {inference} \
+                 (pack the policy with the same model)"
+            ),
+            Self::SegmentCountMismatch { library, policy } => write!(
+                f,
+                "policy has {policy} segments but the library {library} \
+                 (pack the policy with the same library)"
+            ),
+            Self::TableLength {
+                field,
+                expected,
+                found,
+            } => write!(
+                f,
+                "{field} has {found} bytes, its dimensions need {expected}"
+            ),
+            Self::NotFinite { field } => write!(f, "{field} holds a NaN or infinite number"),
+            Self::BadFrameRate => write!(
+                f,
+                "library.fps must be finite, positive and at most {}",
+                super::MAX_FPS
+            ),
+            Self::EmptySegment { segment } => write!(f, "library segment {segment} has no frames"),
+            Self::SegmentOutOfFrames { segment } => write!(
+                f,
+                "library segment {segment} runs past the end of the frame table"
+            ),
+            Self::StrokeOutOfRange { segment } => write!(
+                f,
+                "library segment {segment}: stroke frame is not within the segment"
+            ),
+            Self::BadPwmPeriod => f.write_str(
+                "rig.period_us must be finite, above 2500 us and at most 100000 us \
+                 (20000 us is standard for hobby servos)",
+            ),
+            Self::BadCalibration { channel, error } => {
+                write!(f, "rig channel {channel}: {error}")
+            }
+            Self::ChannelNameCount { expected, found } => write!(
+                f,
+                "rig.channel_names has {found} names for {expected} channels"
+            ),
+            Self::BadDiscount => f.write_str("policy.discount must be in [0, 1]"),
+            Self::ExitSegmentOutOfRange { exit, segment } => write!(
+                f,
+                "exit point {exit} names segment {segment}, which does not exist"
+            ),
+            Self::ExitFrameOutOfRange { exit, frame } => write!(
+                f,
+                "exit point {exit} is at frame {frame}, past the end of its segment"
+            ),
+            Self::ExitsNotSorted { exit } => write!(
+                f,
+                "exit point {exit} is out of order (exits must increase by segment, then frame)"
+            ),
+            Self::MissingEndExit { segment } => {
+                write!(f, "segment {segment} has no exit point at its last frame")
+            }
+            Self::SuccessorOffsetsNotMonotone { exit } => write!(
+                f,
+                "policy.succ_offsets[{exit}] is out of order (must start at 0 and never decrease)"
+            ),
+            Self::SuccessorSegmentOutOfRange { entry, segment } => write!(
+                f,
+                "successor entry {entry} names segment {segment}, which does not exist"
+            ),
+            Self::SuccessorsNotSorted { exit } => write!(
+                f,
+                "exit point {exit}: successors must be sorted by segment, without repeats"
+            ),
+            Self::NoSuccessors { exit } => {
+                write!(f, "exit point {exit} ends its segment but has no successor")
+            }
+        }
+    }
+}
+
+impl core::error::Error for BlobError {
+    fn source(&self) -> Option<&(dyn core::error::Error + 'static)> {
+        match self {
+            Self::FrontEnd(e) => Some(e),
+            Self::BadCalibration { error, .. } => Some(error),
+            _ => None,
+        }
+    }
+}
+
+impl From<ConfigError> for BlobError {
+    fn from(e: ConfigError) -> Self {
+        Self::FrontEnd(e)
+    }
+}

@@ -1,0 +1,233 @@
+//! The payload's wire structs: what postcard encodes after the header, one struct per section,
+//! in declaration order (docs/blob-format.md is the normative description of every field).
+//!
+//! Every table is a borrowed `&[u8]` of little-endian values, so decoding copies nothing: the
+//! structs point into the blob (which may sit in flash). These structs are *unvalidated*: only a
+//! [`Blob`](super::Blob) guarantees that dimensions, lengths and indices agree. The trainer
+//! builds them by borrowing its own vectors and serializes them with postcard, so there is one
+//! definition of the format.
+
+use serde::{Deserialize, Serialize};
+
+use crate::prosody::{PitchParams, ProsodyConfig, SyllableParams};
+
+/// Bytes of one GMM component record (13 little-endian `f32`, in
+/// [`GmmComponent`](crate::inference::GmmComponent) field order).
+pub const GMM_RECORD_BYTES: usize = 13 * 4;
+/// Bytes of one exit-point record (`segment: u16`, `frame: u16`).
+pub const EXIT_RECORD_BYTES: usize = 4;
+/// Bytes of one successor record (`segment: u16`, `cost: i16`).
+pub const SUCCESSOR_RECORD_BYTES: usize = 4;
+/// Bytes of one channel's frame quantization (`scale: f32`, `offset: f32`).
+pub const FRAME_SCALE_RECORD_BYTES: usize = 8;
+/// Bytes of one channel's calibration record (7 little-endian `f32`).
+pub const CALIBRATION_RECORD_BYTES: usize = 7 * 4;
+/// Segment stroke value meaning "no stroke frame".
+pub const NO_STROKE: u16 = 0xFFFF;
+
+/// The whole payload: the five sections in this order.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Payload<'a> {
+    /// Front-end settings.
+    pub front_end: FrontEndSection,
+    /// GMM and CRF.
+    #[serde(borrow)]
+    pub inference: InferenceSection<'a>,
+    /// Value tables, exit points and successors.
+    #[serde(borrow)]
+    pub policy: PolicySection<'a>,
+    /// Gesture segments and their frames.
+    #[serde(borrow)]
+    pub library: LibrarySection<'a>,
+    /// Output channels and their servo calibration.
+    #[serde(borrow)]
+    pub rig: RigSection<'a>,
+}
+
+/// The prosody front-end's settings ([`ProsodyConfig`], flattened).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrontEndSection {
+    /// PCM rate fed to the front-end (Hz).
+    pub sample_rate_hz: u32,
+    /// Lowest F0 considered (Hz).
+    pub pitch_floor_hz: f32,
+    /// Highest F0 considered (Hz).
+    pub pitch_ceiling_hz: f32,
+    /// Relative amplitude below which a frame is silent.
+    pub silence_threshold: f32,
+    /// Minimum normalized autocorrelation for voicing.
+    pub voicing_threshold: f32,
+    /// Preference for higher candidates (per octave).
+    pub octave_cost: f32,
+    /// Path cost of an octave jump.
+    pub octave_jump_cost: f32,
+    /// Path cost of a voiced/unvoiced transition.
+    pub voiced_unvoiced_cost: f32,
+    /// Syllable peak margin above the troughs (dB).
+    pub margin_db: f32,
+    /// Frames this far below the running peak are silence (dB).
+    pub range_db: f32,
+    /// Frames below this level are silence (dB).
+    pub floor_db: f32,
+    /// Starting value of the running peak (dB).
+    pub initial_peak_db: f32,
+    /// Shortest syllable (frames of 10 ms).
+    pub min_frames: u32,
+    /// Length of a pause step (frames of 10 ms).
+    pub pause_frames: u32,
+}
+
+impl FrontEndSection {
+    /// The section holding `c`.
+    pub const fn from_config(c: &ProsodyConfig) -> Self {
+        Self {
+            sample_rate_hz: c.sample_rate_hz,
+            pitch_floor_hz: c.pitch.floor_hz,
+            pitch_ceiling_hz: c.pitch.ceiling_hz,
+            silence_threshold: c.pitch.silence_threshold,
+            voicing_threshold: c.pitch.voicing_threshold,
+            octave_cost: c.pitch.octave_cost,
+            octave_jump_cost: c.pitch.octave_jump_cost,
+            voiced_unvoiced_cost: c.pitch.voiced_unvoiced_cost,
+            margin_db: c.syllables.margin_db,
+            range_db: c.syllables.range_db,
+            floor_db: c.syllables.floor_db,
+            initial_peak_db: c.syllables.initial_peak_db,
+            min_frames: c.syllables.min_frames,
+            pause_frames: c.syllables.pause_frames,
+        }
+    }
+
+    /// The configuration this section describes (not validated here).
+    pub const fn config(&self) -> ProsodyConfig {
+        ProsodyConfig {
+            sample_rate_hz: self.sample_rate_hz,
+            pitch: PitchParams {
+                floor_hz: self.pitch_floor_hz,
+                ceiling_hz: self.pitch_ceiling_hz,
+                silence_threshold: self.silence_threshold,
+                voicing_threshold: self.voicing_threshold,
+                octave_cost: self.octave_cost,
+                octave_jump_cost: self.octave_jump_cost,
+                voiced_unvoiced_cost: self.voiced_unvoiced_cost,
+            },
+            syllables: SyllableParams {
+                margin_db: self.margin_db,
+                range_db: self.range_db,
+                floor_db: self.floor_db,
+                initial_peak_db: self.initial_peak_db,
+                min_frames: self.min_frames,
+                pause_frames: self.pause_frames,
+            },
+        }
+    }
+}
+
+/// A table of little-endian `i16`: value `i` is `i16 * scale`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct I16Section<'a> {
+    /// Multiplier of every value.
+    pub scale: f32,
+    /// `2 * len` bytes.
+    #[serde(borrow)]
+    pub bytes: &'a [u8],
+}
+
+/// The inference layer: prosody clusters and CRF weights.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InferenceSection<'a> {
+    /// Hidden states S.
+    pub states: u8,
+    /// Prosody clusters K.
+    pub clusters: u8,
+    /// CRF input window W (syllables).
+    pub window: u8,
+    /// K records of 13 `f32` in [`GmmComponent`](crate::inference::GmmComponent) field order.
+    #[serde(borrow)]
+    pub gmm: &'a [u8],
+    /// CRF initial weights (S).
+    #[serde(borrow)]
+    pub crf_init: I16Section<'a>,
+    /// CRF transition weights (S x S, from-major).
+    #[serde(borrow)]
+    pub crf_trans: I16Section<'a>,
+    /// CRF observation weights (S x W x K, index `(j * W + w) * K + k`).
+    #[serde(borrow)]
+    pub crf_obs: I16Section<'a>,
+}
+
+/// The control layer in factorized form (DESIGN.md, "It factorizes; store it that way").
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PolicySection<'a> {
+    /// Hidden states S (equals the inference section's).
+    pub states: u8,
+    /// Library segments (equals the library section's).
+    pub segments: u16,
+    /// Exit points.
+    pub exit_points: u16,
+    /// Discount gamma of the value iteration (informational; in `[0, 1]`).
+    pub discount: f32,
+    /// U(a', s): cost-to-go of entering segment a' in state s (segments x S, segment-major).
+    #[serde(borrow)]
+    pub u: I16Section<'a>,
+    /// U_cont(e, s): cost-to-go of continuing past exit point e in state s (exit points x S).
+    #[serde(borrow)]
+    pub u_cont: I16Section<'a>,
+    /// Per exit point: `segment: u16`, `frame: u16` (frame within the segment), sorted.
+    #[serde(borrow)]
+    pub exits: &'a [u8],
+    /// `u32` per exit point plus one: exit e's successors are entries
+    /// `succ_offsets[e]..succ_offsets[e + 1]`.
+    #[serde(borrow)]
+    pub succ_offsets: &'a [u8],
+    /// Per entry: `segment: u16`, `cost: i16` (cost = `i16 * succ_cost_scale`).
+    #[serde(borrow)]
+    pub succ: &'a [u8],
+    /// Multiplier of the successor costs.
+    pub succ_cost_scale: f32,
+}
+
+/// The gesture library as output-channel frames.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LibrarySection<'a> {
+    /// Output channels per frame (equals the rig's).
+    pub channels: u16,
+    /// Frame rate (frames per second).
+    pub fps: f32,
+    /// Frames in the frame table.
+    pub frames: u32,
+    /// Segments.
+    pub segments: u16,
+    /// `u32` per segment: index of its first frame in the frame table.
+    #[serde(borrow)]
+    pub seg_start: &'a [u8],
+    /// `u16` per segment: its length in frames (>= 1).
+    #[serde(borrow)]
+    pub seg_len: &'a [u8],
+    /// Per channel: `scale: f32`, `offset: f32`; value = `offset + scale * i16` (degrees).
+    #[serde(borrow)]
+    pub frame_scales: &'a [u8],
+    /// `i16` values, frames x channels, frame-major.
+    #[serde(borrow)]
+    pub frame_values: &'a [u8],
+    /// `u16` per segment: stroke frame within the segment, [`NO_STROKE`] if none.
+    #[serde(borrow)]
+    pub strokes: &'a [u8],
+    /// `u8` per segment: semantic label, 0 = none.
+    #[serde(borrow)]
+    pub labels: &'a [u8],
+}
+
+/// The output rig: channel names and servo calibration.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigSection<'a> {
+    /// Rig name.
+    pub name: &'a str,
+    /// PWM period (microseconds).
+    pub period_us: f32,
+    /// Per channel 7 `f32`, in [`ChannelCal`](crate::rig::ChannelCal) field order.
+    #[serde(borrow)]
+    pub calibration: &'a [u8],
+    /// Channel names separated by `'\n'`, one per channel.
+    pub channel_names: &'a str,
+}

@@ -1,0 +1,342 @@
+//! Field validation of a decoded payload, in the order of docs/blob-format.md ("Validation"):
+//! front_end, inference, library, rig, policy (the policy indexes into the library, so the
+//! library is checked first). Each check returns the first rule broken; O(payload size), no
+//! allocation, no panics (all index arithmetic is checked or bounded by the capacities).
+
+use super::error::{BlobError, Field};
+use super::payload::*;
+use super::{calibration_from_record, MAX_SEGMENTS};
+use super::{f32_at, record, u16_at, u32_at, MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES};
+use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
+use crate::prosody::FrontEnd;
+use crate::rig::{PERIOD_MAX_US, PULSE_MAX_US};
+
+/// What the accessors need precomputed.
+pub(super) struct Validated<'a> {
+    pub crf: CrfWeights<'a>,
+    pub u: I16Table<'a>,
+    pub u_cont: I16Table<'a>,
+}
+
+pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
+    front_end(&p.front_end)?;
+    let crf = inference(&p.inference)?;
+    library(&p.library)?;
+    rig(&p.rig, p.library.channels as usize)?;
+    let (u, u_cont) = policy(&p.policy, &p.inference, &p.library)?;
+    Ok(Validated { crf, u, u_cont })
+}
+
+/// A count in `1..=max`.
+fn count(n: usize, max: usize, field: Field, too_large: BlobError) -> Result<usize, BlobError> {
+    match n {
+        0 => Err(BlobError::ZeroCount { field }),
+        n if n > max => Err(too_large),
+        n => Ok(n),
+    }
+}
+
+/// `bytes` must be `records * size` long.
+fn length(field: Field, bytes: &[u8], records: usize, size: usize) -> Result<(), BlobError> {
+    // Dimensions are bounded by the capacities, so this cannot overflow on 32-bit targets.
+    let expected = records.saturating_mul(size);
+    if bytes.len() == expected {
+        Ok(())
+    } else {
+        Err(BlobError::TableLength {
+            field,
+            expected,
+            found: bytes.len(),
+        })
+    }
+}
+
+/// A scale whose largest multiple of an `i16` is finite.
+fn scale_ok(scale: f32) -> bool {
+    (scale * 32768.0).is_finite()
+}
+
+fn i16_table<'a>(field: Field, s: &I16Section<'a>, len: usize) -> Result<I16Table<'a>, BlobError> {
+    length(field, s.bytes, len, 2)?;
+    if !scale_ok(s.scale) {
+        return Err(BlobError::NotFinite { field });
+    }
+    I16Table::new(s.bytes, s.scale, len).ok_or(BlobError::NotFinite { field })
+}
+
+fn front_end(f: &FrontEndSection) -> Result<(), BlobError> {
+    FrontEnd::new(&f.config())
+        .map(drop)
+        .map_err(BlobError::FrontEnd)
+}
+
+fn inference<'a>(p: &InferenceSection<'a>) -> Result<CrfWeights<'a>, BlobError> {
+    let s = p.states as usize;
+    let k = p.clusters as usize;
+    let w = p.window as usize;
+    count(
+        s,
+        MAX_STATES,
+        Field::States,
+        BlobError::StateCountTooLarge { found: s as u32 },
+    )?;
+    count(
+        k,
+        MAX_CLUSTERS,
+        Field::Clusters,
+        BlobError::ClusterCountTooLarge { found: k as u32 },
+    )?;
+    count(
+        w,
+        MAX_WINDOW,
+        Field::Window,
+        BlobError::WindowTooLarge { found: w as u32 },
+    )?;
+    length(Field::Gmm, p.gmm, k, GMM_RECORD_BYTES)?;
+    if !p.gmm.chunks_exact(4).all(|c| {
+        c.first_chunk::<4>()
+            .is_some_and(|b| f32::from_le_bytes(*b).is_finite())
+    }) {
+        return Err(BlobError::NotFinite { field: Field::Gmm });
+    }
+    let init = i16_table(Field::CrfInit, &p.crf_init, s)?;
+    let trans = i16_table(Field::CrfTrans, &p.crf_trans, s * s)?;
+    let obs = i16_table(Field::CrfObs, &p.crf_obs, s * w * k)?;
+    // Cannot fail after the checks above; mapped rather than unwrapped.
+    CrfWeights::new(s, k, w, init, trans, obs).ok_or(BlobError::TableLength {
+        field: Field::CrfObs,
+        expected: 2 * s * w * k,
+        found: p.crf_obs.bytes.len(),
+    })
+}
+
+fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
+    let ch = l.channels as usize;
+    let frames = l.frames as usize;
+    let segs = l.segments as usize;
+    count(
+        ch,
+        MAX_CHANNELS,
+        Field::Channels,
+        BlobError::TooManyChannels { found: ch as u32 },
+    )?;
+    if !(l.fps.is_finite() && l.fps > 0.0 && l.fps <= MAX_FPS) {
+        return Err(BlobError::BadFrameRate);
+    }
+    count(
+        frames,
+        MAX_FRAMES,
+        Field::Frames,
+        BlobError::TooManyFrames { found: l.frames },
+    )?;
+    count(
+        segs,
+        MAX_SEGMENTS,
+        Field::Segments,
+        BlobError::TooManySegments { found: segs as u32 },
+    )?;
+    length(Field::SegStart, l.seg_start, segs, 4)?;
+    length(Field::SegLen, l.seg_len, segs, 2)?;
+    length(
+        Field::FrameScales,
+        l.frame_scales,
+        ch,
+        FRAME_SCALE_RECORD_BYTES,
+    )?;
+    length(Field::FrameValues, l.frame_values, frames * ch, 2)?;
+    length(Field::Strokes, l.strokes, segs, 2)?;
+    length(Field::Labels, l.labels, segs, 1)?;
+    for c in 0..ch {
+        let (scale, offset) = (
+            f32_at(l.frame_scales, 2 * c).unwrap_or(f32::NAN),
+            f32_at(l.frame_scales, 2 * c + 1).unwrap_or(f32::NAN),
+        );
+        if !(scale_ok(scale)
+            && offset.is_finite()
+            && (offset.abs() + scale.abs() * 32768.0).is_finite())
+        {
+            return Err(BlobError::NotFinite {
+                field: Field::FrameScales,
+            });
+        }
+    }
+    for s in 0..segs {
+        let segment = s as u32;
+        let start = u32_at(l.seg_start, s).unwrap_or(u32::MAX) as u64;
+        let len = u16_at(l.seg_len, s).unwrap_or(0);
+        if len == 0 {
+            return Err(BlobError::EmptySegment { segment });
+        }
+        if start + len as u64 > l.frames as u64 {
+            return Err(BlobError::SegmentOutOfFrames { segment });
+        }
+        let stroke = u16_at(l.strokes, s).unwrap_or(NO_STROKE);
+        if stroke != NO_STROKE && stroke >= len {
+            return Err(BlobError::StrokeOutOfRange { segment });
+        }
+    }
+    Ok(())
+}
+
+fn rig(r: &RigSection<'_>, channels: usize) -> Result<(), BlobError> {
+    // The rule of `ServoRig::new`, so a loaded blob always builds a rig.
+    if !(r.period_us.is_finite() && r.period_us > PULSE_MAX_US && r.period_us <= PERIOD_MAX_US) {
+        return Err(BlobError::BadPwmPeriod);
+    }
+    length(
+        Field::Calibration,
+        r.calibration,
+        channels,
+        CALIBRATION_RECORD_BYTES,
+    )?;
+    for (ch, rec) in r
+        .calibration
+        .chunks_exact(CALIBRATION_RECORD_BYTES)
+        .enumerate()
+    {
+        let cal = rec
+            .first_chunk::<CALIBRATION_RECORD_BYTES>()
+            .map(calibration_from_record);
+        if let Some(Err(error)) = cal.map(|c| c.validate()) {
+            return Err(BlobError::BadCalibration {
+                channel: ch as u32,
+                error,
+            });
+        }
+    }
+    let names = r.channel_names.split('\n').count();
+    if names != channels {
+        return Err(BlobError::ChannelNameCount {
+            expected: channels as u32,
+            found: names as u32,
+        });
+    }
+    Ok(())
+}
+
+fn exit_at(exits: &[u8], e: usize) -> (u16, u16) {
+    match record::<EXIT_RECORD_BYTES>(exits, e) {
+        Some(r) => (
+            u16::from_le_bytes([r[0], r[1]]),
+            u16::from_le_bytes([r[2], r[3]]),
+        ),
+        None => (u16::MAX, u16::MAX),
+    }
+}
+
+fn policy<'a>(
+    p: &PolicySection<'a>,
+    inf: &InferenceSection<'_>,
+    lib: &LibrarySection<'_>,
+) -> Result<(I16Table<'a>, I16Table<'a>), BlobError> {
+    if p.states != inf.states {
+        return Err(BlobError::StateCountMismatch {
+            inference: inf.states as u32,
+            policy: p.states as u32,
+        });
+    }
+    if p.segments != lib.segments {
+        return Err(BlobError::SegmentCountMismatch {
+            library: lib.segments as u32,
+            policy: p.segments as u32,
+        });
+    }
+    let s = p.states as usize;
+    let segs = p.segments as usize;
+    let n = p.exit_points as usize;
+    count(
+        n,
+        MAX_EXITS,
+        Field::ExitPoints,
+        BlobError::TooManyExits { found: n as u32 },
+    )?;
+    if !(p.discount.is_finite() && (0.0..=1.0).contains(&p.discount)) {
+        return Err(BlobError::BadDiscount);
+    }
+    let u = i16_table(Field::U, &p.u, segs * s)?;
+    let u_cont = i16_table(Field::UCont, &p.u_cont, n * s)?;
+    length(Field::Exits, p.exits, n, EXIT_RECORD_BYTES)?;
+    length(Field::SuccOffsets, p.succ_offsets, n + 1, 4)?;
+    let seg_len = |seg: usize| u16_at(lib.seg_len, seg).unwrap_or(0);
+
+    // Exit points: in range, strictly increasing by (segment, frame).
+    let mut prev: Option<(u16, u16)> = None;
+    for e in 0..n {
+        let (seg, frame) = exit_at(p.exits, e);
+        let exit = e as u32;
+        if seg as usize >= segs {
+            return Err(BlobError::ExitSegmentOutOfRange {
+                exit,
+                segment: seg as u32,
+            });
+        }
+        if frame >= seg_len(seg as usize) {
+            return Err(BlobError::ExitFrameOutOfRange {
+                exit,
+                frame: frame as u32,
+            });
+        }
+        if prev.is_some_and(|q| q >= (seg, frame)) {
+            return Err(BlobError::ExitsNotSorted { exit });
+        }
+        prev = Some((seg, frame));
+    }
+    // Every segment ends in an exit point: its last exit is at its last frame.
+    let mut e = 0;
+    for seg in 0..segs {
+        let mut last = None;
+        while e < n && exit_at(p.exits, e).0 as usize == seg {
+            last = Some(exit_at(p.exits, e).1);
+            e += 1;
+        }
+        if last != Some(seg_len(seg).wrapping_sub(1)) {
+            return Err(BlobError::MissingEndExit {
+                segment: seg as u32,
+            });
+        }
+    }
+
+    // Successor lists: offsets from 0, never decreasing, ending at the entry count.
+    let off = |i: usize| u32_at(p.succ_offsets, i).unwrap_or(u32::MAX);
+    if off(0) != 0 {
+        return Err(BlobError::SuccessorOffsetsNotMonotone { exit: 0 });
+    }
+    for i in 1..=n {
+        if off(i) < off(i - 1) {
+            return Err(BlobError::SuccessorOffsetsNotMonotone { exit: i as u32 });
+        }
+    }
+    let entries = off(n) as u64;
+    if p.succ.len() as u64 != entries * SUCCESSOR_RECORD_BYTES as u64 {
+        return Err(BlobError::TableLength {
+            field: Field::Succ,
+            expected: usize::try_from(entries * SUCCESSOR_RECORD_BYTES as u64)
+                .unwrap_or(usize::MAX),
+            found: p.succ.len(),
+        });
+    }
+    if !scale_ok(p.succ_cost_scale) {
+        return Err(BlobError::NotFinite { field: Field::Succ });
+    }
+    for (i, c) in p.succ.chunks_exact(SUCCESSOR_RECORD_BYTES).enumerate() {
+        let seg = u16::from_le_bytes([c[0], c[1]]);
+        if seg as usize >= segs {
+            return Err(BlobError::SuccessorSegmentOutOfRange {
+                entry: i as u32,
+                segment: seg as u32,
+            });
+        }
+    }
+    let succ_seg = |i: usize| u16_at(p.succ, 2 * i).unwrap_or(u16::MAX);
+    for e in 0..n {
+        let (a, b) = (off(e) as usize, off(e + 1) as usize);
+        if (a + 1..b).any(|i| succ_seg(i) <= succ_seg(i - 1)) {
+            return Err(BlobError::SuccessorsNotSorted { exit: e as u32 });
+        }
+        let (seg, frame) = exit_at(p.exits, e);
+        if frame == seg_len(seg as usize).wrapping_sub(1) && a == b {
+            return Err(BlobError::NoSuccessors { exit: e as u32 });
+        }
+    }
+    Ok((u, u_cont))
+}
