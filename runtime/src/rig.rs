@@ -50,8 +50,11 @@ use embedded_hal::pwm::SetDutyCycle;
 /// [`ServoRig::apply`]).
 pub const SLEW_SLACK: f32 = 1e-4;
 
-/// Most channels a rig may have (the rig file and the blob are checked against it).
-pub const MAX_CHANNELS: usize = 32;
+/// Most channels a rig (and so a pose) may have; the rig file and the blob are checked
+/// against it. Large enough for the full-skeleton rig of a 75-joint body with fingers
+/// (ZeroEGGS: 225 rotation channels), which the simulator uses for BVH output; a pose of this
+/// size is 1 KiB of `f32`.
+pub const MAX_CHANNELS: usize = 256;
 
 /// Shortest pulse a calibration may ask for (us); hobby servos accept 500..=2500 us.
 pub const PULSE_MIN_US: f32 = 500.0;
@@ -164,6 +167,16 @@ pub fn duty_cycle(pulse_us: f32, period_us: f32, max_duty: u16) -> u16 {
     }
 }
 
+/// Checks a PWM period (us): finite, longer than [`PULSE_MAX_US`] and at most
+/// [`PERIOD_MAX_US`].
+pub fn validate_period(period_us: f32) -> Result<(), RigError> {
+    if period_us.is_finite() && period_us > PULSE_MAX_US && period_us <= PERIOD_MAX_US {
+        Ok(())
+    } else {
+        Err(RigError::BadPeriod)
+    }
+}
+
 /// What is wrong with a [`ChannelCal`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CalError {
@@ -252,9 +265,7 @@ impl<P: SetDutyCycle, const N: usize> ServoRig<P, N> {
         if N > MAX_CHANNELS {
             return Err(RigError::TooManyChannels);
         }
-        if !(period_us.is_finite() && period_us > PULSE_MAX_US && period_us <= PERIOD_MAX_US) {
-            return Err(RigError::BadPeriod);
-        }
+        validate_period(period_us)?;
         for (channel, cal) in cals.iter().enumerate() {
             cal.validate()
                 .map_err(|error| RigError::Calibration { channel, error })?;

@@ -12,6 +12,8 @@
 //!   front-end (never re-implemented here).
 //! - [`motion`]: BVH reading/writing, forward kinematics, end effectors, segmentation into
 //!   gesture phases and the six kinematic parameters per segment with their normalization.
+//! - [`rig`]: TOML rig files (output channels mapped to joint rotations by name aliases, with
+//!   servo calibration), binding to a skeleton, per-frame channel angles, the full-skeleton rig.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -22,4 +24,5 @@ pub mod corpus;
 pub mod features;
 pub mod inference;
 pub mod motion;
+pub mod rig;
 pub mod synth;
