@@ -8,6 +8,8 @@
 //!
 //! - [`audio`]: WAV files (8-48 kHz, any common PCM/float encoding) to mono `i16` at the
 //!   front-end rate, band-limited resampling with timing and length preserved.
+//! - [`blob`]: writing policy blobs: owned payload sections, table layout and quantization,
+//!   header + postcard encoding checked by the runtime's loader, atomic file write.
 //! - [`features`]: prosody frames and syllable steps, computed by calling the runtime's
 //!   front-end (never re-implemented here).
 //! - [`motion`]: BVH reading/writing, forward kinematics, end effectors, segmentation into
@@ -18,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod audio;
+pub mod blob;
 pub mod cli;
 pub mod control;
 pub mod corpus;

@@ -4,6 +4,7 @@
 
 pub mod eval_inference;
 pub mod fit;
+pub mod inspect;
 mod stats;
 mod synth;
 
@@ -31,6 +32,8 @@ pub enum Command {
     Fit(fit::FitArgs),
     /// Compare CRF, remapped HMM and prior on held-out data (the paper's Fig. 4).
     EvalInference(eval_inference::EvalArgs),
+    /// Validate a policy blob and summarize it: header, section sizes, dimensions, rig.
+    Inspect(inspect::InspectArgs),
 }
 
 /// Options shared by commands that read a corpus.
@@ -106,6 +109,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::CorpusStats(a) => stats::run(&a),
         Command::Fit(a) => fit::run(&a),
         Command::EvalInference(a) => eval_inference::run(&a),
+        Command::Inspect(a) => inspect::run(&a),
     }
 }
 

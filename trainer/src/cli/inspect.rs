@@ -1,0 +1,99 @@
+//! `gesture-train inspect BLOB`: validates a policy blob with the runtime's own loader and
+//! prints its header, section sizes and dimensions. A refused blob is one error line naming the
+//! file and the runtime's typed error.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use gesture_runtime::blob::Blob;
+
+use super::CliError;
+
+/// Arguments of `inspect`.
+#[derive(Debug, clap::Args)]
+pub struct InspectArgs {
+    /// Policy blob to summarize.
+    pub blob: PathBuf,
+}
+
+/// Runs the command.
+pub fn run(a: &InspectArgs) -> Result<(), CliError> {
+    let name = a.blob.display();
+    let bytes = std::fs::read(&a.blob).map_err(|e| format!("{name}: {e}"))?;
+    let blob = Blob::parse(&bytes).map_err(|e| format!("{name}: {e}"))?;
+    print!("{}", summary(&blob));
+    Ok(())
+}
+
+/// The summary printed by `inspect`, one fact group per line.
+pub fn summary(b: &Blob<'_>) -> String {
+    let mut s = String::new();
+    let h = b.header();
+    let z = b.section_sizes();
+    let total = h.payload_len as usize + gesture_runtime::blob::HEADER_LEN;
+    // Writing to a String cannot fail.
+    let _ = writeln!(
+        s,
+        "blob: {total} bytes, format version {}, flags {:#06x}, payload {} bytes, CRC-32 {:#010x}",
+        h.version, h.flags, h.payload_len, h.crc
+    );
+    let _ = writeln!(
+        s,
+        "sections (bytes): front_end {}, inference {}, policy {}, library {}, rig {}",
+        z.front_end, z.inference, z.policy, z.library, z.rig
+    );
+    let c = b.prosody_config();
+    let _ = writeln!(
+        s,
+        "front_end: {} Hz, pitch {}-{} Hz, syllable margin {} dB, pause step {} frames",
+        c.sample_rate_hz,
+        c.pitch.floor_hz,
+        c.pitch.ceiling_hz,
+        c.syllables.margin_db,
+        c.syllables.pause_frames
+    );
+    let _ = writeln!(
+        s,
+        "inference: {} states, {} clusters, window {}",
+        b.states(),
+        b.clusters(),
+        b.window()
+    );
+    let ends = (0..b.exit_points()).filter(|&e| b.exit_is_end(e)).count();
+    let entries = b.successor_entries();
+    let _ = writeln!(
+        s,
+        "policy: {} segments, {} exit points ({} end, {} interruption), {} successor entries \
+         ({:.2} per exit point), discount {}",
+        b.segments(),
+        b.exit_points(),
+        ends,
+        b.exit_points() - ends,
+        entries,
+        entries as f64 / b.exit_points().max(1) as f64,
+        b.discount()
+    );
+    let segs: Vec<_> = (0..b.segments()).filter_map(|i| b.segment(i)).collect();
+    let _ = writeln!(
+        s,
+        "library: {} segments, {} frames, {} channels, {} fps ({:.2} s of frames), {} with a \
+         stroke, {} labelled",
+        b.segments(),
+        b.frames(),
+        b.channels(),
+        b.fps(),
+        b.frames() as f64 / b.fps() as f64,
+        segs.iter().filter(|x| x.stroke.is_some()).count(),
+        segs.iter().filter(|x| x.label.is_some()).count()
+    );
+    let names: Vec<&str> = b.channel_names().collect();
+    let _ = writeln!(
+        s,
+        "rig: {:?}, PWM period {} us, {} channels: {}",
+        b.rig_name(),
+        b.period_us(),
+        b.channels(),
+        names.join(", ")
+    );
+    s
+}

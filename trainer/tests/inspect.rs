@@ -1,0 +1,98 @@
+//! `gesture-train inspect`: the summary of a valid blob, and one typed error line (exit 2) for
+//! a corrupted, wrong-version, truncated or missing one.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use gesture_trainer::blob::{encode, write_blob, OwnedPayload};
+
+fn inspect(path: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gesture-train"))
+        .arg("inspect")
+        .arg(path)
+        .output()
+        .unwrap()
+}
+
+fn refused(path: &Path, want: &str) {
+    let out = inspect(path);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    let prefix = format!("gesture-train: {}: ", path.display());
+    assert!(err.starts_with(&prefix), "{err}");
+    assert!(err.contains(want), "{err}");
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn summarizes_a_valid_blob() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("example.blob");
+    let n = write_blob(&path, &OwnedPayload::example().payload()).unwrap();
+    let out = inspect(&path);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    for want in [
+        format!(
+            "blob: {n} bytes, format version 1, flags 0x0000, payload {} bytes",
+            n - 16
+        ),
+        "sections (bytes): front_end ".to_string(),
+        "front_end: 16000 Hz, pitch 75-600 Hz".to_string(),
+        "inference: 2 states, 1 clusters, window 1".to_string(),
+        "policy: 2 segments, 3 exit points (2 end, 1 interruption), 4 successor entries \
+         (1.33 per exit point), discount 0.9"
+            .to_string(),
+        "library: 2 segments, 6 frames, 1 channels, 30 fps (0.20 s of frames), 1 with a \
+         stroke, 1 labelled"
+            .to_string(),
+        "rig: \"example\", PWM period 20000 us, 1 channels: head".to_string(),
+    ] {
+        assert!(text.contains(&want), "missing {want:?} in\n{text}");
+    }
+    // Section sizes add up to the payload.
+    let sizes: usize = text
+        .lines()
+        .find(|l| l.starts_with("sections"))
+        .unwrap()
+        .split(", ")
+        .map(|p| p.rsplit(' ').next().unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(sizes, n - 16);
+}
+
+#[test]
+fn bad_blobs_give_one_typed_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = encode(&OwnedPayload::example().payload()).unwrap();
+    let write = |name: &str, bytes: &[u8]| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    };
+
+    let mut b = good.clone();
+    let last = b.len() - 1;
+    b[last] ^= 1;
+    refused(&write("flipped.blob", &b), "CRC-32 mismatch");
+
+    let mut b = good.clone();
+    b[4] = 2;
+    refused(&write("v2.blob", &b), "unsupported blob format version 2");
+
+    refused(
+        &write("cut.blob", &good[..good.len() - 10]),
+        "truncated blob",
+    );
+    refused(&write("tiny.blob", &good[..5]), "blob too short");
+    refused(
+        &write("text.blob", b"hello, world, not a blob"),
+        "bad magic",
+    );
+    refused(&dir.path().join("missing.blob"), "No such file");
+}
