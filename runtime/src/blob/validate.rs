@@ -9,7 +9,7 @@ use super::{calibration_from_record, MAX_SEGMENTS};
 use super::{f32_at, record, u16_at, u32_at, MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES};
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
 use crate::prosody::FrontEnd;
-use crate::rig::{PERIOD_MAX_US, PULSE_MAX_US};
+use crate::rig::validate_period;
 
 /// What the accessors need precomputed.
 pub(super) struct Validated<'a> {
@@ -180,7 +180,7 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
 
 fn rig(r: &RigSection<'_>, channels: usize) -> Result<(), BlobError> {
     // The rule of `ServoRig::new`, so a loaded blob always builds a rig.
-    if !(r.period_us.is_finite() && r.period_us > PULSE_MAX_US && r.period_us <= PERIOD_MAX_US) {
+    if validate_period(r.period_us).is_err() {
         return Err(BlobError::BadPwmPeriod);
     }
     length(
