@@ -288,6 +288,10 @@ fn golden_bytes_and_round_trip() {
         ]
     );
     assert_eq!(blob.successors(1).len(), 0);
+    assert_eq!(blob.successor_count(2), 2);
+    assert_eq!(blob.successor(2, 1).map(|x| x.segment), Some(1));
+    assert_eq!(blob.successor(2, 2), None);
+    assert_eq!(blob.successor(usize::MAX, 0), None);
     assert_eq!(
         blob.successors(2).map(|s| s.segment).collect::<Vec<_>>(),
         [0, 1]

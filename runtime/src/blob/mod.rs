@@ -190,19 +190,29 @@ pub struct Successors<'a> {
     scale: f32,
 }
 
+impl Successors<'_> {
+    fn decode(&self, c: &[u8]) -> Option<Successor> {
+        match *c {
+            [a, b, c, d] => Some(Successor {
+                segment: u16::from_le_bytes([a, b]),
+                cost: i16::from_le_bytes([c, d]) as f32 * self.scale,
+            }),
+            _ => None,
+        }
+    }
+}
+
 impl Iterator for Successors<'_> {
     type Item = Successor;
 
     fn next(&mut self) -> Option<Successor> {
         let c = self.chunks.next()?;
-        let (s, k) = match c {
-            &[a, b, c, d] => (u16::from_le_bytes([a, b]), i16::from_le_bytes([c, d])),
-            _ => return None,
-        };
-        Some(Successor {
-            segment: s,
-            cost: k as f32 * self.scale,
-        })
+        self.decode(c)
+    }
+
+    fn nth(&mut self, n: usize) -> Option<Successor> {
+        let c = self.chunks.nth(n)?;
+        self.decode(c)
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
@@ -553,6 +563,16 @@ impl<'a> Blob<'a> {
             chunks: range.unwrap_or(&[]).chunks_exact(SUCCESSOR_RECORD_BYTES),
             scale: p.succ_cost_scale,
         }
+    }
+
+    /// Number of successors of exit point `exit` (0 if out of range).
+    pub fn successor_count(&self, exit: usize) -> usize {
+        self.successors(exit).len()
+    }
+
+    /// The `k`-th successor of exit point `exit`, in stored (segment) order; O(1).
+    pub fn successor(&self, exit: usize, k: usize) -> Option<Successor> {
+        self.successors(exit).nth(k)
     }
 
     // --- library ---
