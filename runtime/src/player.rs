@@ -6,7 +6,7 @@
 //! output).
 
 /// Most rig channels a pose can have.
-pub const MAX_CHANNELS: usize = 32;
+pub const MAX_CHANNELS: usize = crate::rig::MAX_CHANNELS;
 /// Frames over which a cut is blended.
 pub const BLEND_FRAMES: usize = 3;
 

@@ -23,12 +23,13 @@
 //! access, so a blob can stay in flash; a [`Blob`] is a few hundred bytes of slices and
 //! dimensions. Parsing walks the payload once (CRC, decode, validation), O(size).
 //!
-//! Loading needs stack for one front-end configuration check ([`FrontEnd::new`], about 9 KiB)
-//! on top of the parse itself (a few hundred bytes).
+//! Loading checks the front-end settings with [`ProsodyConfig::validate`] (no front-end is
+//! built), so it needs only a few hundred bytes of stack.
 
 mod crc;
 mod error;
 mod payload;
+mod tables;
 mod validate;
 
 use core::num::NonZeroU8;

@@ -117,7 +117,10 @@ impl<'a> I16Table<'a> {
     /// Value `i` (0 past the end; validated tables are never indexed past the end).
     #[inline]
     pub fn get(&self, i: usize) -> f32 {
-        match self.bytes.get(2 * i..2 * i + 2) {
+        let Some(lo) = i.checked_mul(2) else {
+            return 0.0;
+        };
+        match self.bytes.get(lo..lo.saturating_add(2)) {
             Some(b) => i16::from_le_bytes([b[0], b[1]]) as f32 * self.scale,
             None => 0.0,
         }

@@ -71,6 +71,54 @@ impl ProsodyConfig {
         pitch: PitchParams::PRAAT,
         syllables: SyllableParams::DEFAULT,
     };
+
+    /// Checks the settings without building a front-end (cheap, no large stack use).
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let rate = self.sample_rate_hz;
+        if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) || rate % 1000 != 0 {
+            return Err(ConfigError::UnsupportedSampleRate(rate));
+        }
+        let p = &self.pitch;
+        let all_ok = [
+            p.silence_threshold,
+            p.voicing_threshold,
+            p.octave_cost,
+            p.octave_jump_cost,
+            p.voiced_unvoiced_cost,
+        ]
+        .iter()
+        .all(|&v| finite_nonneg(v));
+        if !all_ok {
+            return Err(ConfigError::PitchParams);
+        }
+        let pitch_rate = if rate > MIN_RATE_HZ { rate / 2 } else { rate };
+        if !(p.floor_hz.is_finite() && p.ceiling_hz.is_finite())
+            || p.floor_hz < 75.0
+            || p.ceiling_hz <= 2.0 * p.floor_hz
+            || p.ceiling_hz * 4.0 > pitch_rate as f32
+        {
+            return Err(ConfigError::PitchRange);
+        }
+        // The window sizes for these settings must fit the fixed capacities.
+        let nominal = libm::floorf(3.0 * pitch_rate as f32 / p.floor_hz) as usize;
+        if 2 * (nominal / 2).saturating_sub(1) > pitch::MAX_WINDOW
+            || libm::ceilf(3.2e3 / p.floor_hz) as usize > intensity::MAX_HALF_BLOCKS
+        {
+            return Err(ConfigError::PitchRange);
+        }
+        let s = &self.syllables;
+        let positive = |v: f32| v.is_finite() && v > 0.0;
+        if !positive(s.margin_db)
+            || !positive(s.range_db)
+            || !s.floor_db.is_finite()
+            || !s.initial_peak_db.is_finite()
+            || s.min_frames == 0
+            || s.pause_frames == 0
+        {
+            return Err(ConfigError::SyllableParams);
+        }
+        Ok(())
+    }
 }
 
 impl Default for ProsodyConfig {
@@ -177,45 +225,14 @@ pub struct FrontEnd {
 impl FrontEnd {
     /// A front-end for `config`, or why the config is refused.
     pub fn new(config: &ProsodyConfig) -> Result<Self, ConfigError> {
+        config.validate()?;
         let rate = config.sample_rate_hz;
-        if !(MIN_RATE_HZ..=MAX_RATE_HZ).contains(&rate) || rate % 1000 != 0 {
-            return Err(ConfigError::UnsupportedSampleRate(rate));
-        }
         let p = &config.pitch;
-        let all_ok = [
-            p.silence_threshold,
-            p.voicing_threshold,
-            p.octave_cost,
-            p.octave_jump_cost,
-            p.voiced_unvoiced_cost,
-        ]
-        .iter()
-        .all(|&v| finite_nonneg(v));
-        if !all_ok {
-            return Err(ConfigError::PitchParams);
-        }
         let decimate = rate > MIN_RATE_HZ;
         let pitch_rate = if decimate { rate / 2 } else { rate };
-        if !(p.floor_hz.is_finite() && p.ceiling_hz.is_finite())
-            || p.floor_hz < 75.0
-            || p.ceiling_hz <= 2.0 * p.floor_hz
-            || p.ceiling_hz * 4.0 > pitch_rate as f32
-        {
-            return Err(ConfigError::PitchRange);
-        }
         let analyzer = PitchAnalyzer::new(pitch_rate, *p).ok_or(ConfigError::PitchRange)?;
         let intensity = Intensity::new(rate, p.floor_hz).ok_or(ConfigError::PitchRange)?;
         let s = &config.syllables;
-        let positive = |v: f32| v.is_finite() && v > 0.0;
-        if !positive(s.margin_db)
-            || !positive(s.range_db)
-            || !s.floor_db.is_finite()
-            || !s.initial_peak_db.is_finite()
-            || s.min_frames == 0
-            || s.pause_frames == 0
-        {
-            return Err(ConfigError::SyllableParams);
-        }
         Ok(Self {
             config: *config,
             hop: rate / 100,

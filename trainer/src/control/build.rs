@@ -292,3 +292,35 @@ pub fn regret(
         regret: excess / best_total.max(1e-12),
     }
 }
+
+/// Truncates `cm` to the largest number of successors per exit whose blob fits `budget`
+/// bytes, as measured by `size(kept)`; returns that number (`None` if even one successor per
+/// exit does not fit). Bisection over `k`, since the size grows with `k`.
+pub fn fit_budget(
+    model: &InferenceModel,
+    cm: &mut ControlModel,
+    budget: usize,
+    size: &dyn Fn(&ControlModel) -> usize,
+) -> Option<usize> {
+    let max_k = cm.pruned.iter().map(Vec::len).max().unwrap_or(1).max(1);
+    cm.kept = cm.pruned.clone();
+    if size(cm) <= budget {
+        return Some(max_k);
+    }
+    let (mut lo, mut hi) = (0usize, max_k);
+    while hi - lo > 1 {
+        let mid = (lo + hi) / 2;
+        cm.kept = keep_best(&cm.policy, &cm.pruned, &model.state_prior, mid);
+        if size(cm) <= budget {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    if lo == 0 {
+        cm.kept = keep_best(&cm.policy, &cm.pruned, &model.state_prior, 1);
+        return None;
+    }
+    cm.kept = keep_best(&cm.policy, &cm.pruned, &model.state_prior, lo);
+    Some(lo)
+}

@@ -87,7 +87,8 @@ pub fn psi(lib: &Library, states: &[Gaussian], samples: usize) -> Vec<Vec<f64>> 
         .collect()
 }
 
-/// Per-segment signature for [`segment_distance`] and the scales of junction distances.
+/// Per-segment signature for [`Signatures::segment_distance`] and the scales of junction
+/// distances.
 #[derive(Clone, Debug)]
 pub struct Signatures {
     sig: Vec<Vec<f64>>,

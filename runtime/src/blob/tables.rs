@@ -1,0 +1,58 @@
+//! A validated blob is the controller's policy and library: the [`PolicyTables`] and
+//! [`LibraryFrames`] views. Every index the controller passes was range-checked at load, and
+//! the blob's accessors return neutral values for anything else, so nothing here can panic.
+
+use super::Blob;
+use crate::player::LibraryFrames;
+use crate::policy::PolicyTables;
+
+impl PolicyTables for Blob<'_> {
+    fn states(&self) -> usize {
+        Blob::states(self)
+    }
+    fn exit_count(&self) -> usize {
+        self.exit_points()
+    }
+    fn exit_segment(&self, e: usize) -> usize {
+        self.exit(e).map_or(0, |x| x.segment as usize)
+    }
+    fn exit_frame(&self, e: usize) -> usize {
+        self.exit(e).map_or(0, |x| x.frame as usize)
+    }
+    fn exit_is_end(&self, e: usize) -> bool {
+        Blob::exit_is_end(self, e)
+    }
+    fn first_exit(&self, c: usize) -> usize {
+        self.exits_of(c).start
+    }
+    fn u(&self, c: usize, s: usize) -> f32 {
+        Blob::u(self, c, s)
+    }
+    fn u_cont(&self, e: usize, s: usize) -> f32 {
+        Blob::u_cont(self, e, s)
+    }
+    fn successor_count(&self, e: usize) -> usize {
+        Blob::successor_count(self, e)
+    }
+    fn successor(&self, e: usize, k: usize) -> (usize, f32) {
+        Blob::successor(self, e, k).map_or((0, f32::INFINITY), |s| (s.segment as usize, s.cost))
+    }
+}
+
+impl LibraryFrames for Blob<'_> {
+    fn channels(&self) -> usize {
+        Blob::channels(self)
+    }
+    fn fps(&self) -> f32 {
+        Blob::fps(self)
+    }
+    fn segment_count(&self) -> usize {
+        self.segments()
+    }
+    fn segment_len(&self, c: usize) -> usize {
+        self.segment(c).map_or(1, |s| s.len as usize)
+    }
+    fn value(&self, c: usize, f: usize, ch: usize) -> f32 {
+        self.segment_value(c, f, ch)
+    }
+}
