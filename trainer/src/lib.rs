@@ -27,5 +27,6 @@ pub mod corpus;
 pub mod features;
 pub mod inference;
 pub mod motion;
+pub mod pack;
 pub mod rig;
 pub mod synth;

@@ -5,6 +5,7 @@
 pub mod eval_inference;
 pub mod fit;
 pub mod inspect;
+pub mod pack;
 mod stats;
 mod synth;
 
@@ -32,6 +33,8 @@ pub enum Command {
     Fit(fit::FitArgs),
     /// Compare CRF, remapped HMM and prior on held-out data (the paper's Fig. 4).
     EvalInference(eval_inference::EvalArgs),
+    /// Pack a model, a gesture library and a rig into a policy blob.
+    Pack(pack::PackArgs),
     /// Validate a policy blob and summarize it: header, section sizes, dimensions, rig.
     Inspect(inspect::InspectArgs),
 }
@@ -109,6 +112,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::CorpusStats(a) => stats::run(&a),
         Command::Fit(a) => fit::run(&a),
         Command::EvalInference(a) => eval_inference::run(&a),
+        Command::Pack(a) => pack::run(&a),
         Command::Inspect(a) => inspect::run(&a),
     }
 }

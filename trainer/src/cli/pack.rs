@@ -1,0 +1,82 @@
+//! `gesture-train pack`: model + library + rig into a policy blob, with a JSON report.
+
+use std::path::PathBuf;
+
+use super::{CliError, CorpusArgs};
+use crate::pack::{pack, PackOptions};
+
+/// Arguments of `pack`.
+#[derive(Debug, clap::Args)]
+pub struct PackArgs {
+    /// Trained inference model (from `gesture-train fit`).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Gesture library: BVH files or folders (WAV files are ignored).
+    #[arg(long, required = true, num_args = 1..)]
+    pub library: Vec<PathBuf>,
+    /// Rig file (TOML); default: every rotation channel of the library's skeleton.
+    #[arg(long)]
+    pub rig: Option<PathBuf>,
+    /// Largest blob size in bytes; successor lists are truncated to fit (with regret reported).
+    #[arg(long)]
+    pub budget_bytes: Option<usize>,
+    /// Output blob.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Write the pack report (JSON) here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Corpus loading options (effectors).
+    #[command(flatten)]
+    pub load: CorpusArgs,
+}
+
+/// Runs the command.
+pub fn run(a: &PackArgs) -> Result<(), CliError> {
+    let opts = PackOptions {
+        rig: a.rig.clone(),
+        budget_bytes: a.budget_bytes,
+        effectors: a.load.options().effectors,
+        ..PackOptions::default()
+    };
+    let r = pack(&a.model, &a.library, &opts, &a.out)?;
+    println!(
+        "wrote {}: {} bytes (front-end {}, inference {}, policy {}, library {}, rig {})",
+        a.out.display(),
+        r.blob_bytes,
+        r.section_bytes.front_end,
+        r.section_bytes.inference,
+        r.section_bytes.policy,
+        r.section_bytes.library,
+        r.section_bytes.rig
+    );
+    println!(
+        "library: {} segments, {} exit points, {} frames; rig {} ({} channels)",
+        r.segments, r.exit_points, r.frames, r.rig, r.channels
+    );
+    println!(
+        "successors: {} of {} kept ({:.2}% pruned{}); regret {:.4}%, agreement {:.2}% over {} simulated decisions",
+        r.entries_kept,
+        r.entries_total,
+        100.0 * r.pruned_fraction,
+        r.successors_per_exit
+            .map_or(String::new(), |k| format!(", at most {k} per exit point for the budget")),
+        100.0 * r.regret,
+        100.0 * r.agreement,
+        r.regret_decisions
+    );
+    println!(
+        "time: load {:.2} s, costs {:.2} s, value iteration {:.2} s, pruning {:.2} s, write {:.2} s, total {:.2} s",
+        r.timings.load_s,
+        r.timings.costs_s,
+        r.timings.value_iteration_s,
+        r.timings.pruning_s,
+        r.timings.write_s,
+        r.timings.total_s
+    );
+    if let Some(p) = &a.report {
+        let text = serde_json::to_string_pretty(&r)?;
+        crate::blob::write_atomic(p, text.as_bytes())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,295 @@
+//! Packing: a trained inference model plus a gesture library (any BVH files) plus a rig into
+//! one policy blob (DESIGN.md "New library, same model": only the control layer is computed
+//! here; the inference layer is reused as trained).
+//!
+//! Steps: read the library and segment it like the corpus; bind the rig to its skeleton and
+//! turn every frame into channel angles; solve the control layer and prune it; if a byte budget
+//! is given, keep the best `k` successors per exit point with the largest `k` that fits;
+//! quantize; write atomically; measure the regret of the pruned, quantized policy against the
+//! float unpruned one on simulated belief traces.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use gesture_runtime::blob::{Blob, FrontEndSection};
+use gesture_runtime::prosody::ProsodyConfig;
+use serde::Serialize;
+
+use crate::blob::{
+    encode, write_atomic, OwnedInference, OwnedLibrary, OwnedPayload, OwnedPolicy, OwnedRig,
+    PolicyInput, SegmentSpec,
+};
+use crate::control::build::{
+    build, fit_budget, regret, ControlModel, ControlParams, QuantizedPolicy,
+};
+use crate::control::Library;
+use crate::corpus::discover;
+use crate::inference::model::InferenceModel;
+use crate::inference::quantize::QuantizedInference;
+use crate::motion::{EffectorSpec, SegmentParams};
+use crate::rig::Rig;
+
+/// Settings of a pack.
+#[derive(Clone, Debug, Default)]
+pub struct PackOptions {
+    /// Rig file (default: every rotation channel of the library's skeleton).
+    pub rig: Option<PathBuf>,
+    /// Largest blob in bytes.
+    pub budget_bytes: Option<usize>,
+    /// Control-layer settings.
+    pub control: ControlParams,
+    /// End effectors for segmenting the library.
+    pub effectors: EffectorSpec,
+}
+
+/// Bytes per blob section.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct SectionBytes {
+    /// Header (16).
+    pub header: usize,
+    /// Front-end settings.
+    pub front_end: usize,
+    /// GMM and CRF.
+    pub inference: usize,
+    /// Value tables and successor lists.
+    pub policy: usize,
+    /// Library frames.
+    pub library: usize,
+    /// Rig calibration.
+    pub rig: usize,
+}
+
+/// Stage timings (s).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct PackTimings {
+    /// Model, library and rig reading and binding.
+    pub load_s: f64,
+    /// psi and successor costs.
+    pub costs_s: f64,
+    /// Value iteration.
+    pub value_iteration_s: f64,
+    /// Pruning (and budget truncation).
+    pub pruning_s: f64,
+    /// Quantization, encoding and writing.
+    pub write_s: f64,
+    /// Regret simulation.
+    pub regret_s: f64,
+    /// Everything.
+    pub total_s: f64,
+}
+
+/// The pack report (`--report`).
+#[derive(Clone, Debug, Serialize)]
+pub struct PackReport {
+    /// Blob size.
+    pub blob_bytes: usize,
+    /// Bytes per section.
+    pub section_bytes: SectionBytes,
+    /// Library segments.
+    pub segments: usize,
+    /// Exit points.
+    pub exit_points: usize,
+    /// Successor entries before pruning (exit points x segments).
+    pub entries_total: usize,
+    /// Entries after exact pruning.
+    pub entries_nondominated: usize,
+    /// Entries in the blob.
+    pub entries_kept: usize,
+    /// `1 - entries_kept / entries_total`.
+    pub pruned_fraction: f64,
+    /// Successors per exit point kept by the budget (`null`: all non-dominated).
+    pub successors_per_exit: Option<usize>,
+    /// Expected cost of the pruned, quantized policy over the float unpruned one.
+    pub regret: f64,
+    /// Fraction of simulated decisions equal to the float unpruned policy's.
+    pub agreement: f64,
+    /// Decisions simulated for the regret.
+    pub regret_decisions: usize,
+    /// Rig name and channels.
+    pub rig: String,
+    /// Rig channels.
+    pub channels: usize,
+    /// Library frames stored.
+    pub frames: usize,
+    /// Timings.
+    pub timings: PackTimings,
+}
+
+/// Why packing failed.
+pub type PackError = Box<dyn std::error::Error + Send + Sync>;
+
+struct Parts {
+    inference: OwnedInference,
+    library: OwnedLibrary,
+    rig: OwnedRig,
+    front_end: FrontEndSection,
+}
+
+fn policy_section(
+    model: &InferenceModel,
+    lib: &Library,
+    cm: &ControlModel,
+) -> Result<(OwnedPolicy, QuantizedPolicy), PackError> {
+    let q = QuantizedPolicy::new(lib, cm);
+    let exits: Vec<(usize, usize)> = q.exits.iter().map(|&(s, f, _)| (s, f)).collect();
+    let owned = OwnedPolicy::new(&PolicyInput {
+        states: model.states(),
+        segments: lib.segments.len(),
+        discount: cm_discount(cm),
+        u: &q.u,
+        u_cont: &q.u_cont,
+        exits: &exits,
+        successors: &q.succ,
+        succ_cost_scale: q.succ_scale,
+    })?;
+    Ok((owned, q))
+}
+
+fn cm_discount(_cm: &ControlModel) -> f64 {
+    crate::control::MdpParams::default().discount
+}
+
+fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, PackError> {
+    let payload = OwnedPayload {
+        front_end: parts.front_end,
+        inference: parts.inference.clone(),
+        policy: policy.clone(),
+        library: parts.library.clone(),
+        rig: parts.rig.clone(),
+    };
+    Ok(encode(&payload.payload())?)
+}
+
+/// Packs `model` and the BVH files in `library` into `out`; returns the report.
+pub fn pack(
+    model_path: &Path,
+    library: &[PathBuf],
+    opts: &PackOptions,
+    out: &Path,
+) -> Result<PackReport, PackError> {
+    let start = Instant::now();
+    let model = InferenceModel::load(model_path)?;
+    let files: Vec<PathBuf> = discover(library)?
+        .into_iter()
+        .filter_map(|t| t.bvh)
+        .collect();
+    if files.is_empty() {
+        return Err("the library has no .bvh files".into());
+    }
+    let lib = Library::from_files(
+        &files,
+        &model.normalization,
+        &opts.effectors,
+        &SegmentParams::default(),
+        3,
+    )?;
+    let rig = match &opts.rig {
+        Some(p) => Rig::load(p)?,
+        None => Rig::full_skeleton(lib.takes[0].motion.skeleton())?,
+    };
+    // Channel angles of every frame, take after take.
+    let mut frames: Vec<Vec<f32>> = Vec::new();
+    let mut offsets = Vec::with_capacity(lib.takes.len());
+    for t in &lib.takes {
+        let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
+        offsets.push(frames.len());
+        let values = bound
+            .take_values(&t.motion)
+            .ok_or_else(|| format!("{}: the rig does not fit this skeleton", t.source.display()))?;
+        frames.extend(values);
+    }
+    let segments: Vec<SegmentSpec> = lib
+        .segments
+        .iter()
+        .map(|s| SegmentSpec {
+            start: offsets[s.take] + s.start,
+            len: s.len(),
+            stroke: None,
+            label: 0,
+        })
+        .collect();
+    let cals: Vec<(String, gesture_runtime::rig::ChannelCal)> = rig
+        .channels
+        .iter()
+        .map(|c| (c.name.clone(), c.cal))
+        .collect();
+    let config = ProsodyConfig {
+        sample_rate_hz: model.sample_rate_hz,
+        ..ProsodyConfig::DEFAULT
+    };
+    let parts = Parts {
+        inference: OwnedInference::new(&QuantizedInference::new(&model.gmm, &model.crf))?,
+        library: OwnedLibrary::new(lib.fps, rig.channels.len(), &frames, &segments)?,
+        rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
+        front_end: FrontEndSection::from_config(&config),
+    };
+    let load_s = start.elapsed().as_secs_f64();
+
+    let mut cm = build(&model, &lib, &opts.control);
+    let t_prune = Instant::now();
+    let mut k = None;
+    if let Some(budget) = opts.budget_bytes {
+        let size = |c: &ControlModel| {
+            policy_section(&model, &lib, c)
+                .and_then(|(p, _)| encode_with(&parts, &p))
+                .map_or(usize::MAX, |b| b.len())
+        };
+        k = fit_budget(&model, &mut cm, budget, &size);
+        if k.is_none() {
+            return Err(format!(
+                "the blob does not fit {budget} bytes even with one successor per exit point \
+                 ({} bytes): use a smaller library, fewer rig channels, or a larger budget",
+                size(&cm)
+            )
+            .into());
+        }
+        if k == cm.pruned.iter().map(Vec::len).max() {
+            k = None;
+        }
+    }
+    let pruning_extra = t_prune.elapsed().as_secs_f64();
+    let t_write = Instant::now();
+    let (policy, q) = policy_section(&model, &lib, &cm)?;
+    let bytes = encode_with(&parts, &policy)?;
+    write_atomic(out, &bytes)?;
+    let blob = Blob::parse(&bytes).map_err(|e| format!("{}: {e}", out.display()))?;
+    let sizes = blob.section_sizes();
+    let write_s = t_write.elapsed().as_secs_f64();
+    let t_regret = Instant::now();
+    let decisions = 20_000;
+    let r = regret(&lib, &cm, &q, &model, decisions, 7);
+    let regret_s = t_regret.elapsed().as_secs_f64();
+    Ok(PackReport {
+        blob_bytes: bytes.len(),
+        section_bytes: SectionBytes {
+            header: gesture_runtime::blob::HEADER_LEN,
+            front_end: sizes.front_end,
+            inference: sizes.inference,
+            policy: sizes.policy,
+            library: sizes.library,
+            rig: sizes.rig,
+        },
+        segments: lib.segments.len(),
+        exit_points: lib.exits.len(),
+        entries_total: cm.entries_total(),
+        entries_nondominated: cm.pruned.iter().map(Vec::len).sum(),
+        entries_kept: cm.entries_kept(),
+        pruned_fraction: 1.0 - cm.entries_kept() as f64 / cm.entries_total().max(1) as f64,
+        successors_per_exit: k,
+        regret: r.regret,
+        agreement: r.agreement,
+        regret_decisions: decisions,
+        rig: rig.name.clone(),
+        channels: rig.channels.len(),
+        frames: frames.len(),
+        timings: PackTimings {
+            load_s,
+            costs_s: cm.timings.costs,
+            value_iteration_s: cm.timings.value_iteration,
+            pruning_s: cm.timings.pruning + pruning_extra,
+            write_s,
+            regret_s,
+            total_s: start.elapsed().as_secs_f64(),
+        },
+    })
+}
