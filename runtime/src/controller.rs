@@ -171,7 +171,25 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         }
     }
 
+    /// Ends the input stream: the front-end reports the frames still in its windows and closes
+    /// an open syllable (as [`FrontEnd::finish`] does), each step updating the belief as
+    /// usual. No tick is played. Pushing more samples afterwards starts a new front-end stream
+    /// (the belief, playback and sample clock go on).
+    pub fn finish(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        self.front_end_run(None, sink);
+    }
+
     fn feed(&mut self, samples: &[i16], sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        self.front_end_run(Some(samples), sink);
+        self.samples += samples.len() as u64;
+    }
+
+    /// Pushes `samples` through the front-end (or finishes it with `None`), stepping the belief.
+    fn front_end_run(
+        &mut self,
+        samples: Option<&[i16]>,
+        sink: &mut impl FnMut(ControllerEvent<'_>),
+    ) {
         let (normalizer, belief, gmm, clusters, crf, states) = (
             &mut self.normalizer,
             &mut self.belief,
@@ -180,7 +198,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             &self.crf,
             self.tables.states(),
         );
-        self.front_end.push(samples, &mut |ev| match ev {
+        let mut on_event = |ev| match ev {
             Event::Frame(f) => sink(ControllerEvent::Frame(f)),
             Event::Step(step) => {
                 let x = normalizer.push(&step);
@@ -192,8 +210,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                     belief: belief.probs(states),
                 });
             }
-        });
-        self.samples += samples.len() as u64;
+        };
+        match samples {
+            Some(s) => self.front_end.push(s, &mut on_event),
+            None => self.front_end.finish(&mut on_event),
+        }
     }
 
     fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {

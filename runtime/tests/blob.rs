@@ -68,6 +68,62 @@ struct Tiny {
     period_us: f32,
     calibration: Vec<u8>,
     channel_names: String,
+    skeleton: Option<TinySkeleton>,
+}
+
+/// The tiny blob's skeleton: `hips` (6 channels) with child `head` (3 rotations, an end site);
+/// the rig channel `head` reads `head`'s own Yrotation channel.
+#[derive(Clone)]
+struct TinySkeleton {
+    joints: u16,
+    joint_names: String,
+    parents: Vec<u8>,
+    offsets: Vec<u8>,
+    channel_counts: Vec<u8>,
+    channel_codes: Vec<u8>,
+    rest: Vec<u8>,
+    end_sites: Vec<u8>,
+    drives: Vec<u8>,
+}
+
+impl TinySkeleton {
+    fn new() -> Self {
+        let mut end_sites = le_u16(&[1]);
+        end_sites.extend(le_f32(&[0.0, 5.0, 0.0]));
+        Self {
+            joints: 2,
+            joint_names: "hips\nhead".into(),
+            parents: le_u16(&[ROOT_PARENT, 0]),
+            offsets: le_f32(&[0.0, 0.0, 0.0, 0.0, 10.0, 0.0]),
+            channel_counts: vec![6, 3],
+            channel_codes: vec![0, 1, 2, 5, 3, 4, 5, 3, 4],
+            rest: le_f32(&[0.0, 90.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            end_sites,
+            drives: Drive {
+                joint: 1,
+                chain_top: 1,
+                axis: 1,
+                negated: false,
+                mode: DriveMode::Channel,
+            }
+            .record()
+            .to_vec(),
+        }
+    }
+
+    fn section(&self) -> SkeletonSection<'_> {
+        SkeletonSection {
+            joints: self.joints,
+            joint_names: &self.joint_names,
+            parents: &self.parents,
+            offsets: &self.offsets,
+            channel_counts: &self.channel_counts,
+            channel_codes: &self.channel_codes,
+            rest: &self.rest,
+            end_sites: &self.end_sites,
+            drives: &self.drives,
+        }
+    }
 }
 
 impl Tiny {
@@ -106,6 +162,7 @@ impl Tiny {
             period_us: 20_000.0,
             calibration: calibration_record(&ChannelCal::HOBBY).to_vec(),
             channel_names: "head".into(),
+            skeleton: Some(TinySkeleton::new()),
         }
     }
 
@@ -157,6 +214,7 @@ impl Tiny {
                 calibration: &self.calibration,
                 channel_names: &self.channel_names,
             },
+            skeleton: self.skeleton.as_ref().map(TinySkeleton::section),
         }
     }
 
@@ -194,7 +252,7 @@ fn hex(b: &[u8]) -> String {
 /// The tiny blob's bytes. Changing the format changes these: bump FORMAT_VERSION and update
 /// docs/blob-format.md with them.
 const GOLDEN: &str = concat!(
-    "47535442010000003d010000ee44e1ed",
+    "4753544202000000af0100005c5acdf8",
     "807d00009642000016448fc2f53c6666e63e0ad7233c3333b33e295c0f3e0000",
     "00400000c8410000c84100008c42061902010134000000bf000080bf0000803e",
     "0000c0bf000000400000003f000080400000a0bf0000003e0000003f000080be",
@@ -204,7 +262,11 @@ const GOLDEN: &str = concat!(
     "0000020000000400000010000005000100fbff0000070001000000cdcccc3d01",
     "0000f04106020800000000030000000403000300080ad7233c000020410c0000",
     "6400c8002c019cff38ff04ffff01000200020474696e7900409c461c00000000",
-    "0000b4c20000b4420000803f0080bb440000204100007a430468656164",
+    "0000b4c20000b4420000803f0080bb440000204100007a430468656164010209",
+    "686970730a6865616404ffff0000180000000000000000000000000000000000",
+    "002041000000000206030900010205030405030424000000000000b442000000",
+    "000000000000000000000000000000000000000000000000000e010000000000",
+    "0000a0400000000006010001000101",
 );
 
 #[test]
@@ -231,7 +293,7 @@ fn golden_bytes_and_round_trip() {
     assert_eq!(h.payload_len as usize, bytes.len() - HEADER_LEN);
     let sz = blob.section_sizes();
     assert_eq!(
-        sz.front_end + sz.inference + sz.policy + sz.library + sz.rig,
+        sz.front_end + sz.inference + sz.policy + sz.library + sz.rig + sz.skeleton,
         h.payload_len as usize
     );
     assert_eq!(sz.front_end, postcard_len(&tiny.payload().front_end));
@@ -326,6 +388,47 @@ fn golden_bytes_and_round_trip() {
     assert_eq!(blob.calibration(1), None);
     assert_eq!(blob.channel_name(0), Some("head"));
     assert_eq!(blob.channel_names().collect::<Vec<_>>(), ["head"]);
+    // skeleton
+    assert_eq!(sz.skeleton, postcard_len(&tiny.payload().skeleton));
+    let sk = blob.skeleton().unwrap();
+    assert_eq!((sk.joints(), sk.channel_count(), sk.drives()), (2, 9, 1));
+    assert_eq!(sk.joint_names().collect::<Vec<_>>(), ["hips", "head"]);
+    assert_eq!((sk.joint_name(1), sk.joint_name(2)), (Some("head"), None));
+    assert_eq!(
+        (sk.parent(0), sk.parent(1), sk.parent(2)),
+        (None, Some(0), None)
+    );
+    assert_eq!(sk.offset(1), [0.0, 10.0, 0.0]);
+    assert_eq!(sk.offset(9), [0.0; 3]);
+    assert_eq!((sk.joint_channels(0), sk.joint_channels(1)), (0..6, 6..9));
+    assert_eq!(sk.joint_channels(2), 0..0);
+    assert_eq!((sk.channel_code(3), sk.channel_code(9)), (Some(5), None));
+    assert_eq!((sk.rest(1), sk.rest(99)), (90.0, 0.0));
+    assert_eq!(
+        (sk.end_site(0), sk.end_site(1)),
+        (None, Some([0.0, 5.0, 0.0]))
+    );
+    assert_eq!(
+        sk.drive(0),
+        Some(Drive {
+            joint: 1,
+            chain_top: 1,
+            axis: 1,
+            negated: false,
+            mode: DriveMode::Channel
+        })
+    );
+    assert_eq!(sk.drive(1), None);
+    for code in 0..8u8 {
+        assert_eq!(DriveMode::from_code(code).map(DriveMode::code), Some(code));
+    }
+    assert_eq!(DriveMode::from_code(8), None);
+    // Without the section: one byte (postcard's None), and no skeleton.
+    let mut bare = Tiny::new();
+    bare.skeleton = None;
+    let bytes = bare.encode();
+    let b = Blob::parse(&bytes).unwrap();
+    assert_eq!((b.skeleton(), b.section_sizes().skeleton), (None, 1));
 }
 
 fn postcard_len<T: serde::Serialize>(v: &T) -> usize {
@@ -374,6 +477,12 @@ fn variant(e: &BlobError) -> &'static str {
         BlobError::SuccessorSegmentOutOfRange { .. } => "SuccessorSegmentOutOfRange",
         BlobError::SuccessorsNotSorted { .. } => "SuccessorsNotSorted",
         BlobError::NoSuccessors { .. } => "NoSuccessors",
+        BlobError::TooManyJoints { .. } => "TooManyJoints",
+        BlobError::JointNameCount { .. } => "JointNameCount",
+        BlobError::BadParent { .. } => "BadParent",
+        BlobError::BadJointChannels { .. } => "BadJointChannels",
+        BlobError::BadEndSite { .. } => "BadEndSite",
+        BlobError::BadDrive { .. } => "BadDrive",
     }
 }
 
@@ -415,6 +524,12 @@ const ALL: &[&str] = &[
     "SuccessorSegmentOutOfRange",
     "SuccessorsNotSorted",
     "NoSuccessors",
+    "TooManyJoints",
+    "JointNameCount",
+    "BadParent",
+    "BadJointChannels",
+    "BadEndSite",
+    "BadDrive",
 ];
 
 #[test]
@@ -442,8 +557,11 @@ fn every_error_variant_is_reachable() {
     b[0] = b'X';
     check(&b, BlobError::BadMagic);
     let mut b = good.clone();
-    b[4] = 2;
-    check(&b, BlobError::UnsupportedVersion { found: 2 });
+    b[4] = 1;
+    check(&b, BlobError::UnsupportedVersion { found: 1 });
+    let mut b = good.clone();
+    b[4] = 3;
+    check(&b, BlobError::UnsupportedVersion { found: 3 });
     let mut b = good.clone();
     b[6] = 1;
     check(&b, BlobError::UnsupportedFlags { found: 1 });
@@ -489,10 +607,19 @@ fn every_error_variant_is_reachable() {
     check(
         &b,
         BlobError::Malformed {
-            section: Section::Rig,
+            section: Section::Skeleton,
         },
     );
     let mut b = good.clone();
+    b.truncate(b.len() - 3);
+    fix_crc(&mut b);
+    check(
+        &b,
+        BlobError::Malformed {
+            section: Section::Skeleton,
+        },
+    );
+    let mut b = mutated(&|t| t.skeleton = None);
     b.truncate(b.len() - 3);
     fix_crc(&mut b);
     check(
@@ -755,6 +882,128 @@ fn every_error_variant_is_reachable() {
         BlobError::NoSuccessors { exit: 2 },
     );
 
+    // skeleton.
+    let sk = |f: &dyn Fn(&mut TinySkeleton)| {
+        mutated(&|t| {
+            if let Some(s) = t.skeleton.as_mut() {
+                f(s)
+            }
+        })
+    };
+    check(
+        &sk(&|s| s.joints = 0),
+        BlobError::ZeroCount {
+            field: Field::Joints,
+        },
+    );
+    check(
+        &sk(&|s| s.joints = MAX_JOINTS as u16 + 1),
+        BlobError::TooManyJoints {
+            found: MAX_JOINTS as u32 + 1,
+        },
+    );
+    check(
+        &sk(&|s| s.joint_names = "hips".into()),
+        BlobError::JointNameCount {
+            expected: 2,
+            found: 1,
+        },
+    );
+    check(
+        &sk(&|s| s.offsets.truncate(20)),
+        BlobError::TableLength {
+            field: Field::Offsets,
+            expected: 24,
+            found: 20,
+        },
+    );
+    check(
+        &sk(&|s| s.channel_counts = vec![6, 2]),
+        BlobError::TableLength {
+            field: Field::ChannelCodes,
+            expected: 8,
+            found: 9,
+        },
+    );
+    check(
+        &sk(&|s| s.rest.truncate(32)),
+        BlobError::TableLength {
+            field: Field::Rest,
+            expected: 36,
+            found: 32,
+        },
+    );
+    check(
+        &sk(&|s| s.end_sites.push(0)),
+        BlobError::TableLength {
+            field: Field::EndSites,
+            expected: 14,
+            found: 15,
+        },
+    );
+    check(
+        &sk(&|s| s.drives.push(0)),
+        BlobError::TableLength {
+            field: Field::Drives,
+            expected: 6,
+            found: 7,
+        },
+    );
+    check(
+        &sk(&|s| s.offsets[4..8].copy_from_slice(&f32::NAN.to_le_bytes())),
+        BlobError::NotFinite {
+            field: Field::Offsets,
+        },
+    );
+    check(
+        &sk(&|s| s.rest[0..4].copy_from_slice(&f32::INFINITY.to_le_bytes())),
+        BlobError::NotFinite { field: Field::Rest },
+    );
+    check(
+        &sk(&|s| s.end_sites[2..6].copy_from_slice(&f32::NAN.to_le_bytes())),
+        BlobError::NotFinite {
+            field: Field::EndSites,
+        },
+    );
+    check(
+        &sk(&|s| s.parents = le_u16(&[ROOT_PARENT, 1])),
+        BlobError::BadParent { joint: 1 },
+    );
+    check(
+        &sk(&|s| s.channel_codes[8] = 6),
+        BlobError::BadJointChannels { joint: 1 },
+    );
+    check(
+        &sk(&|s| s.channel_codes[1] = 0),
+        BlobError::BadJointChannels { joint: 0 },
+    );
+    check(
+        &sk(&|s| s.end_sites[0] = 2),
+        BlobError::BadEndSite { entry: 0 },
+    );
+    check(
+        &sk(&|s| s.drives[0] = 2),
+        BlobError::BadDrive { channel: 0 },
+    );
+    check(
+        &sk(&|s| s.drives[4] = 6),
+        BlobError::BadDrive { channel: 0 },
+    );
+    check(
+        &sk(&|s| s.drives[5] = 8),
+        BlobError::BadDrive { channel: 0 },
+    );
+    // The chain top must be the joint or an ancestor: hips (0) above head (1) is fine, head
+    // above hips is not.
+    assert!(Blob::parse(&sk(&|s| s.drives[2] = 0)).is_ok());
+    check(
+        &sk(&|s| {
+            s.drives[0] = 0;
+            s.drives[2] = 1;
+        }),
+        BlobError::BadDrive { channel: 0 },
+    );
+
     let all: BTreeSet<&str> = ALL.iter().copied().collect();
     let missing: Vec<_> = all.difference(&hit).collect();
     assert!(missing.is_empty(), "never triggered: {missing:?}");
@@ -811,6 +1060,23 @@ fn exercise(b: &Blob<'_>, rng: &mut Lcg) {
         b.pose(rng.below(b.frames() + 2), &mut pose);
         pose.iter().for_each(|&v| fin(v));
         let _ = (b.calibration(rng.below(40)), b.channel_name(rng.below(40)));
+        if let Some(sk) = b.skeleton() {
+            let j = rng.below(sk.joints() + 2);
+            let _ = (
+                sk.joint_name(j),
+                sk.parent(j),
+                sk.end_site(j),
+                sk.drive(rng.below(4)),
+            );
+            sk.offset(j).iter().for_each(|&v| fin(v));
+            for i in sk.joint_channels(j) {
+                fin(sk.rest(i));
+                assert!(sk.channel_code(i).is_some_and(|c| c <= 5));
+            }
+            if let Some(p) = sk.parent(j) {
+                assert!(p < j);
+            }
+        }
     }
     for seg in 0..b.segments() {
         // Every segment ends in an exit with a successor (validated).

@@ -125,6 +125,10 @@ enum Rec {
 }
 
 fn run(audio: &[i16], chunk: usize) -> Vec<Rec> {
+    run_with(audio, chunk, false)
+}
+
+fn run_with(audio: &[i16], chunk: usize, finish: bool) -> Vec<Rec> {
     let t = tables();
     let lib = Lib { lens: [20, 12, 30] };
     let crf_bytes_init = [0u8; 4];
@@ -161,7 +165,32 @@ fn run(audio: &[i16], chunk: usize) -> Vec<Rec> {
     for ch in audio.chunks(chunk.max(1)) {
         c.push(ch, &mut sink);
     }
+    if finish {
+        c.finish(&mut sink);
+    }
     out
+}
+
+#[test]
+fn finish_reports_the_last_steps_without_a_tick() {
+    // Speech that stops mid-syllable (the 3.5 Hz envelope is up at 1.25 s): the open syllable
+    // only ends at `finish`.
+    let audio = speech(1.25);
+    let open = run_with(&audio, 160, false);
+    let done = run_with(&audio, 160, true);
+    assert_eq!(&done[..open.len()], &open[..]);
+    let extra = &done[open.len()..];
+    assert!(!extra.is_empty());
+    assert!(
+        extra.iter().all(|r| matches!(r, Rec::Step(..))),
+        "{extra:?}"
+    );
+    for r in extra {
+        if let Rec::Step(end, b) = r {
+            assert!(*end as f32 * 0.01 <= 1.26 + 0.1, "{end}");
+            assert!((b.iter().sum::<f32>() - 1.0).abs() < 1e-4);
+        }
+    }
 }
 
 #[test]

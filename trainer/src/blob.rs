@@ -12,14 +12,17 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use gesture_runtime::blob::{
-    calibration_record, gmm_record, Blob, BlobError, FrontEndSection, Header, I16Section,
-    InferenceSection, LibrarySection, Payload, PolicySection, RigSection, NO_STROKE,
+    calibration_record, gmm_record, Blob, BlobError, Drive, DriveMode, FrontEndSection, Header,
+    I16Section, InferenceSection, LibrarySection, Payload, PolicySection, RigSection,
+    SkeletonSection, NO_STROKE, ROOT_PARENT,
 };
 use gesture_runtime::inference::GmmComponent;
 use gesture_runtime::prosody::ProsodyConfig;
 use gesture_runtime::rig::ChannelCal;
 
 use crate::inference::quantize::{QTable, QuantizedInference};
+use crate::motion::{Channel, Skeleton};
+use crate::rig::{AngleMode, BoundRig};
 
 /// Why a blob could not be built or written.
 #[derive(Debug, thiserror::Error)]
@@ -342,6 +345,134 @@ impl OwnedRig {
     }
 }
 
+/// Owned `skeleton` section (host-side: the device ignores it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OwnedSkeleton {
+    /// Joints.
+    pub joints: u16,
+    /// `'\n'`-separated joint names.
+    pub joint_names: String,
+    /// `u16` parent per joint.
+    pub parents: Vec<u8>,
+    /// `3 f32` offset per joint.
+    pub offsets: Vec<u8>,
+    /// `u8` channel count per joint.
+    pub channel_counts: Vec<u8>,
+    /// `u8` channel code per channel.
+    pub channel_codes: Vec<u8>,
+    /// `f32` rest value per channel.
+    pub rest: Vec<u8>,
+    /// End-site records.
+    pub end_sites: Vec<u8>,
+    /// Drive records, one per rig channel.
+    pub drives: Vec<u8>,
+}
+
+/// The blob code of a BVH channel (docs/blob-format.md, `skeleton.channel_codes`).
+pub fn channel_code(c: Channel) -> u8 {
+    match c {
+        Channel::Xposition => 0,
+        Channel::Yposition => 1,
+        Channel::Zposition => 2,
+        Channel::Xrotation => 3,
+        Channel::Yrotation => 4,
+        Channel::Zrotation => 5,
+    }
+}
+
+/// What each channel of a bound rig drives, in rig channel order.
+pub fn drives_of(bound: &BoundRig) -> Result<Vec<Drive>, BlobWriteError> {
+    bound
+        .channels()
+        .iter()
+        .map(|c| {
+            let mode = match c.mode {
+                AngleMode::Twist => DriveMode::Twist,
+                AngleMode::Channel => DriveMode::Channel,
+                AngleMode::Euler(o) => DriveMode::Euler([o[0] as u8, o[1] as u8, o[2] as u8]),
+            };
+            Ok(Drive {
+                joint: fit("drive joint", c.joint, "u16")?,
+                chain_top: fit("drive chain top", c.chain_top(), "u16")?,
+                axis: c.axis.index.min(2) as u8,
+                negated: c.axis.negated,
+                mode,
+            })
+        })
+        .collect()
+}
+
+impl OwnedSkeleton {
+    /// The section for `skeleton` with rest pose `rest` (one value per channel of a frame, in
+    /// BVH units) and one drive per rig channel.
+    pub fn new(
+        skeleton: &Skeleton,
+        rest: &[f64],
+        drives: &[Drive],
+    ) -> Result<Self, BlobWriteError> {
+        let n = skeleton.channel_count();
+        if rest.len() != n {
+            return inconsistent(format!(
+                "skeleton rest pose has {} values for {n} channels",
+                rest.len()
+            ));
+        }
+        if let Some(j) = skeleton.joints.iter().find(|j| j.name.contains('\n')) {
+            return inconsistent(format!("joint name {:?} contains a newline", j.name));
+        }
+        let f32s = |v: &mut Vec<u8>, xs: &[f64]| {
+            for &x in xs {
+                v.extend((x as f32).to_le_bytes());
+            }
+        };
+        let mut s = Self {
+            joints: fit("skeleton joints", skeleton.joints.len(), "u16")?,
+            joint_names: skeleton.joint_names().collect::<Vec<_>>().join("\n"),
+            parents: Vec::new(),
+            offsets: Vec::new(),
+            channel_counts: Vec::new(),
+            channel_codes: Vec::new(),
+            rest: Vec::new(),
+            end_sites: Vec::new(),
+            drives: drives.iter().flat_map(Drive::record).collect(),
+        };
+        f32s(&mut s.rest, rest);
+        for (k, j) in skeleton.joints.iter().enumerate() {
+            let parent = match j.parent {
+                Some(p) => fit::<u16>("joint parent", p, "u16")?,
+                None => ROOT_PARENT,
+            };
+            s.parents.extend(parent.to_le_bytes());
+            f32s(&mut s.offsets, &j.offset);
+            s.channel_counts
+                .push(fit("joint channels", j.channels.len(), "u8")?);
+            s.channel_codes
+                .extend(j.channels.iter().map(|&c| channel_code(c)));
+            if let Some(e) = j.end_site {
+                s.end_sites
+                    .extend(fit::<u16>("end-site joint", k, "u16")?.to_le_bytes());
+                f32s(&mut s.end_sites, &e);
+            }
+        }
+        Ok(s)
+    }
+
+    /// The wire form, borrowing from `self`.
+    pub fn section(&self) -> SkeletonSection<'_> {
+        SkeletonSection {
+            joints: self.joints,
+            joint_names: &self.joint_names,
+            parents: &self.parents,
+            offsets: &self.offsets,
+            channel_counts: &self.channel_counts,
+            channel_codes: &self.channel_codes,
+            rest: &self.rest,
+            end_sites: &self.end_sites,
+            drives: &self.drives,
+        }
+    }
+}
+
 /// Everything a blob holds, owned.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OwnedPayload {
@@ -355,6 +486,8 @@ pub struct OwnedPayload {
     pub library: OwnedLibrary,
     /// Output rig.
     pub rig: OwnedRig,
+    /// The library's skeleton (optional, host-side).
+    pub skeleton: Option<OwnedSkeleton>,
 }
 
 fn section(t: &QTable) -> I16Section<'_> {
@@ -409,6 +542,7 @@ impl OwnedPayload {
                 calibration: &r.calibration,
                 channel_names: &r.channel_names,
             },
+            skeleton: self.skeleton.as_ref().map(OwnedSkeleton::section),
         }
     }
 
@@ -465,6 +599,7 @@ impl OwnedPayload {
                 policy,
                 library,
                 rig,
+                skeleton: None,
             },
             _ => unreachable!("the example's fixed tables fit their fields"),
         }

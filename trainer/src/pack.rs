@@ -7,6 +7,14 @@
 //! is given, keep the best `k` successors per exit point with the largest `k` that fits;
 //! quantize; write atomically; measure the regret of the pruned, quantized policy against the
 //! float unpruned one on simulated belief traces.
+//!
+//! **One skeleton per library.** Every take of the library must have the same joint hierarchy
+//! (names, parents, channels; offsets may differ, the first take's are kept), so the blob's
+//! host-side `skeleton` section (docs/blob-format.md 3.6) can describe the motion the frames came
+//! from: the first take's skeleton, its first frame as the rest pose, and what each rig channel
+//! drives. A library that mixes skeletons is refused with the first difference; pack each
+//! skeleton family into its own blob. `--no-skeleton` leaves the section out (the device never
+//! reads it; it costs a few KiB for a 75-joint body).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -16,8 +24,8 @@ use gesture_runtime::prosody::ProsodyConfig;
 use serde::Serialize;
 
 use crate::blob::{
-    encode, write_atomic, OwnedInference, OwnedLibrary, OwnedPayload, OwnedPolicy, OwnedRig,
-    PolicyInput, SegmentSpec,
+    drives_of, encode, write_atomic, OwnedInference, OwnedLibrary, OwnedPayload, OwnedPolicy,
+    OwnedRig, OwnedSkeleton, PolicyInput, SegmentSpec,
 };
 use crate::control::build::{
     build, fit_budget, regret, ControlModel, ControlParams, QuantizedPolicy,
@@ -26,7 +34,7 @@ use crate::control::Library;
 use crate::corpus::discover;
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::QuantizedInference;
-use crate::motion::{EffectorSpec, SegmentParams};
+use crate::motion::{EffectorSpec, SegmentParams, Skeleton};
 use crate::rig::Rig;
 
 /// Settings of a pack.
@@ -40,6 +48,8 @@ pub struct PackOptions {
     pub control: ControlParams,
     /// End effectors for segmenting the library.
     pub effectors: EffectorSpec,
+    /// Leave out the host-side skeleton section.
+    pub no_skeleton: bool,
 }
 
 /// Bytes per blob section.
@@ -57,6 +67,8 @@ pub struct SectionBytes {
     pub library: usize,
     /// Rig calibration.
     pub rig: usize,
+    /// Host-side skeleton (1 byte when left out).
+    pub skeleton: usize,
 }
 
 /// Stage timings (s).
@@ -123,6 +135,7 @@ struct Parts {
     library: OwnedLibrary,
     rig: OwnedRig,
     front_end: FrontEndSection,
+    skeleton: Option<OwnedSkeleton>,
 }
 
 fn policy_section(
@@ -156,6 +169,7 @@ fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, PackError
         policy: policy.clone(),
         library: parts.library.clone(),
         rig: parts.rig.clone(),
+        skeleton: parts.skeleton.clone(),
     };
     Ok(encode(&payload.payload())?)
 }
@@ -187,6 +201,18 @@ pub fn pack(
         Some(p) => Rig::load(p)?,
         None => Rig::full_skeleton(lib.takes[0].motion.skeleton())?,
     };
+    let first = &lib.takes[0];
+    for t in &lib.takes[1..] {
+        if let Some(diff) = skeleton_difference(first.motion.skeleton(), t.motion.skeleton()) {
+            return Err(format!(
+                "the library mixes skeletons: {} and {} differ ({diff}); pack one skeleton per \
+                 library",
+                first.source.display(),
+                t.source.display()
+            )
+            .into());
+        }
+    }
     // Channel angles of every frame, take after take.
     let mut frames: Vec<Vec<f32>> = Vec::new();
     let mut offsets = Vec::with_capacity(lib.takes.len());
@@ -217,11 +243,20 @@ pub fn pack(
         sample_rate_hz: model.sample_rate_hz,
         ..ProsodyConfig::DEFAULT
     };
+    let skeleton = if opts.no_skeleton {
+        None
+    } else {
+        let sk = first.motion.skeleton();
+        let bound = rig.bind(sk, &first.source.display().to_string())?;
+        let rest: Vec<f64> = first.motion.frame(0).unwrap_or(&[]).to_vec();
+        Some(OwnedSkeleton::new(sk, &rest, &drives_of(&bound)?)?)
+    };
     let parts = Parts {
         inference: OwnedInference::new(&QuantizedInference::new(&model.gmm, &model.crf))?,
         library: OwnedLibrary::new(lib.fps, rig.channels.len(), &frames, &segments)?,
         rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
         front_end: FrontEndSection::from_config(&config),
+        skeleton,
     };
     let load_s = start.elapsed().as_secs_f64();
 
@@ -268,6 +303,7 @@ pub fn pack(
             policy: sizes.policy,
             library: sizes.library,
             rig: sizes.rig,
+            skeleton: sizes.skeleton,
         },
         segments: lib.segments.len(),
         exit_points: lib.exits.len(),
@@ -292,4 +328,53 @@ pub fn pack(
             total_s: start.elapsed().as_secs_f64(),
         },
     })
+}
+
+/// The first structural difference between two skeletons (joint count, names, parents,
+/// channels), or `None` if they have the same hierarchy. Offsets are not compared.
+pub fn skeleton_difference(a: &Skeleton, b: &Skeleton) -> Option<String> {
+    if a.joints.len() != b.joints.len() {
+        return Some(format!(
+            "{} joints against {}",
+            a.joints.len(),
+            b.joints.len()
+        ));
+    }
+    a.joints
+        .iter()
+        .zip(&b.joints)
+        .enumerate()
+        .find_map(|(k, (x, y))| {
+            if x.name != y.name {
+                Some(format!("joint {k} is `{}` against `{}`", x.name, y.name))
+            } else if x.parent != y.parent {
+                Some(format!("joint `{}` has another parent", x.name))
+            } else if x.channels != y.channels {
+                Some(format!("joint `{}` has other channels", x.name))
+            } else {
+                None
+            }
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mixed_skeletons_are_told_apart() {
+        let a = crate::synth::skeleton();
+        assert_eq!(skeleton_difference(&a, &a.clone()), None);
+        let mut b = a.clone();
+        b.joints[0].offset[1] += 1.0;
+        assert_eq!(skeleton_difference(&a, &b), None, "offsets may differ");
+        b.joints[2].name = "Other".into();
+        let d = skeleton_difference(&a, &b).unwrap();
+        assert!(d.contains("joint 2") && d.contains("`Other`"), "{d}");
+        let mut c = a.clone();
+        c.joints.pop();
+        assert!(skeleton_difference(&a, &c)
+            .unwrap()
+            .contains("joints against"));
+    }
 }

@@ -831,6 +831,14 @@ pub struct BoundChannel {
     chain: Vec<(usize, usize)>,
 }
 
+impl BoundChannel {
+    /// The first joint of the rotation chain the angle is read from: `joint` itself, or with
+    /// `relative_to` the reference's child on the path down to `joint`.
+    pub fn chain_top(&self) -> usize {
+        self.chain.first().map_or(self.joint, |&(j, _)| j)
+    }
+}
+
 /// A rig resolved against one skeleton: reads channel values from that skeleton's motion.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BoundRig {

@@ -2,13 +2,15 @@
 //! through the runtime's loader, errors, and the atomic file write.
 
 use gesture_runtime::blob::{
-    calibration_record, gmm_record, Blob, BlobError, FrontEndSection, HEADER_LEN, NO_STROKE,
+    calibration_record, gmm_record, Blob, BlobError, Drive, DriveMode, FrontEndSection, HEADER_LEN,
+    NO_STROKE,
 };
 use gesture_runtime::inference::GmmComponent;
 use gesture_runtime::prosody::ProsodyConfig;
 use gesture_runtime::rig::ChannelCal;
 use gesture_trainer::blob::*;
 use gesture_trainer::inference::quantize::{QTable, QuantizedInference};
+use gesture_trainer::motion::{Channel, Joint, Skeleton};
 
 fn q(v: &[i16], scale: f32) -> QTable {
     QTable {
@@ -75,13 +77,52 @@ fn golden_content() -> OwnedPayload {
             calibration: calibration_record(&ChannelCal::HOBBY).to_vec(),
             channel_names: "head".into(),
         },
+        skeleton: Some(tiny_skeleton()),
     }
+}
+
+/// The golden blob's skeleton, built from a BVH skeleton like `pack` does.
+fn tiny_skeleton() -> OwnedSkeleton {
+    let skeleton = Skeleton {
+        joints: vec![
+            Joint {
+                name: "hips".into(),
+                parent: None,
+                offset: [0.0; 3],
+                channels: vec![
+                    Channel::Xposition,
+                    Channel::Yposition,
+                    Channel::Zposition,
+                    Channel::Zrotation,
+                    Channel::Xrotation,
+                    Channel::Yrotation,
+                ],
+                end_site: None,
+            },
+            Joint {
+                name: "head".into(),
+                parent: Some(0),
+                offset: [0.0, 10.0, 0.0],
+                channels: vec![Channel::Zrotation, Channel::Xrotation, Channel::Yrotation],
+                end_site: Some([0.0, 5.0, 0.0]),
+            },
+        ],
+    };
+    let rest = [0.0, 90.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let drive = Drive {
+        joint: 1,
+        chain_top: 1,
+        axis: 1,
+        negated: false,
+        mode: DriveMode::Channel,
+    };
+    OwnedSkeleton::new(&skeleton, &rest, &[drive]).unwrap()
 }
 
 /// Copy of `GOLDEN` in runtime/tests/blob.rs: the writer must produce exactly the bytes the
 /// format's golden test pins.
 const GOLDEN: &str = concat!(
-    "47535442010000003d010000ee44e1ed",
+    "4753544202000000af0100005c5acdf8",
     "807d00009642000016448fc2f53c6666e63e0ad7233c3333b33e295c0f3e0000",
     "00400000c8410000c84100008c42061902010134000000bf000080bf0000803e",
     "0000c0bf000000400000003f000080400000a0bf0000003e0000003f000080be",
@@ -91,7 +132,11 @@ const GOLDEN: &str = concat!(
     "0000020000000400000010000005000100fbff0000070001000000cdcccc3d01",
     "0000f04106020800000000030000000403000300080ad7233c000020410c0000",
     "6400c8002c019cff38ff04ffff01000200020474696e7900409c461c00000000",
-    "0000b4c20000b4420000803f0080bb440000204100007a430468656164",
+    "0000b4c20000b4420000803f0080bb440000204100007a430468656164010209",
+    "686970730a6865616404ffff0000180000000000000000000000000000000000",
+    "002041000000000206030900010205030405030424000000000000b442000000",
+    "000000000000000000000000000000000000000000000000000e010000000000",
+    "0000a0400000000006010001000101",
 );
 
 fn hex(b: &[u8]) -> String {
@@ -101,7 +146,7 @@ fn hex(b: &[u8]) -> String {
 #[test]
 fn writer_produces_the_golden_bytes() {
     let bytes = encode(&golden_content().payload()).unwrap();
-    assert_eq!(bytes.len(), 333);
+    assert_eq!(bytes.len(), 447);
     assert_eq!(hex(&bytes), GOLDEN);
 }
 
@@ -178,6 +223,7 @@ fn constructors_round_trip_through_the_runtime_loader() {
         policy,
         library,
         rig,
+        skeleton: None,
     };
     let bytes = encode(&owned.payload()).unwrap();
     let b = Blob::parse(&bytes).unwrap();

@@ -39,7 +39,7 @@ fn summarizes_a_valid_blob() {
     let text = String::from_utf8(out.stdout).unwrap();
     for want in [
         format!(
-            "blob: {n} bytes, format version 1, flags 0x0000, payload {} bytes",
+            "blob: {n} bytes, format version 2, flags 0x0000, payload {} bytes",
             n - 16
         ),
         "sections (bytes): front_end ".to_string(),
@@ -82,8 +82,8 @@ fn bad_blobs_give_one_typed_error_line() {
     refused(&write("flipped.blob", &b), "CRC-32 mismatch");
 
     let mut b = good.clone();
-    b[4] = 2;
-    refused(&write("v2.blob", &b), "unsupported blob format version 2");
+    b[4] = 1;
+    refused(&write("v1.blob", &b), "unsupported blob format version 1");
 
     refused(
         &write("cut.blob", &good[..good.len() - 10]),

@@ -19,6 +19,8 @@ pub enum Section {
     Library,
     /// Output channels.
     Rig,
+    /// The optional host-side skeleton.
+    Skeleton,
 }
 
 impl Section {
@@ -30,6 +32,7 @@ impl Section {
             Self::Policy => "policy",
             Self::Library => "library",
             Self::Rig => "rig",
+            Self::Skeleton => "skeleton",
         }
     }
 }
@@ -89,6 +92,22 @@ pub enum Field {
     Labels,
     /// `rig.calibration`.
     Calibration,
+    /// `skeleton.joints`.
+    Joints,
+    /// `skeleton.parents`.
+    Parents,
+    /// `skeleton.offsets`.
+    Offsets,
+    /// `skeleton.channel_counts`.
+    ChannelCounts,
+    /// `skeleton.channel_codes`.
+    ChannelCodes,
+    /// `skeleton.rest`.
+    Rest,
+    /// `skeleton.end_sites`.
+    EndSites,
+    /// `skeleton.drives`.
+    Drives,
 }
 
 impl Field {
@@ -118,6 +137,14 @@ impl Field {
             Self::Strokes => "library.strokes",
             Self::Labels => "library.labels",
             Self::Calibration => "rig.calibration",
+            Self::Joints => "skeleton.joints",
+            Self::Parents => "skeleton.parents",
+            Self::Offsets => "skeleton.offsets",
+            Self::ChannelCounts => "skeleton.channel_counts",
+            Self::ChannelCodes => "skeleton.channel_codes",
+            Self::Rest => "skeleton.rest",
+            Self::EndSites => "skeleton.end_sites",
+            Self::Drives => "skeleton.drives",
         }
     }
 }
@@ -145,7 +172,7 @@ pub enum BlobError {
         /// Version in the header.
         found: u16,
     },
-    /// Header flags this runtime does not know (version 1 defines none).
+    /// Header flags this runtime does not know (version 2 defines none).
     UnsupportedFlags {
         /// Flags in the header.
         found: u16,
@@ -335,6 +362,40 @@ pub enum BlobError {
         /// Exit index.
         exit: u32,
     },
+    // --- skeleton ---
+    /// More skeleton joints than [`MAX_JOINTS`](super::MAX_JOINTS).
+    TooManyJoints {
+        /// Joints in the blob.
+        found: u32,
+    },
+    /// `skeleton.joint_names` does not hold one name per joint.
+    JointNameCount {
+        /// Joints.
+        expected: u32,
+        /// Names.
+        found: u32,
+    },
+    /// A joint's parent does not precede it, or the joints are not in depth-first order.
+    BadParent {
+        /// Joint index.
+        joint: u32,
+    },
+    /// A joint has more than 6 channels, an unknown channel code or a channel twice.
+    BadJointChannels {
+        /// Joint index.
+        joint: u32,
+    },
+    /// An end site names a joint that does not exist or is out of order.
+    BadEndSite {
+        /// End-site record index.
+        entry: u32,
+    },
+    /// A rig channel's drive record names a joint that does not exist, a chain top that is not
+    /// the joint or one of its ancestors, or an unknown axis or mode.
+    BadDrive {
+        /// Rig channel index.
+        channel: u32,
+    },
 }
 
 impl fmt::Display for BlobError {
@@ -495,6 +556,32 @@ impl fmt::Display for BlobError {
             Self::NoSuccessors { exit } => {
                 write!(f, "exit point {exit} ends its segment but has no successor")
             }
+            Self::TooManyJoints { found } => write!(
+                f,
+                "{found} skeleton joints, a blob holds at most {} (use a smaller skeleton)",
+                super::MAX_JOINTS
+            ),
+            Self::JointNameCount { expected, found } => write!(
+                f,
+                "skeleton.joint_names has {found} names for {expected} joints"
+            ),
+            Self::BadParent { joint } => write!(
+                f,
+                "skeleton joint {joint}: its parent does not precede it in depth-first order"
+            ),
+            Self::BadJointChannels { joint } => write!(
+                f,
+                "skeleton joint {joint}: more than 6 channels, an unknown channel or a repeat"
+            ),
+            Self::BadEndSite { entry } => write!(
+                f,
+                "skeleton end site {entry} names a missing joint or is out of order"
+            ),
+            Self::BadDrive { channel } => write!(
+                f,
+                "skeleton drive of rig channel {channel}: joint, chain top, axis or mode out \
+                 of range"
+            ),
         }
     }
 }

@@ -6,6 +6,7 @@
 //!  0      4        6      8            12     16
 //!  "GSTB" version  flags  payload_len  crc32  postcard payload (payload_len bytes)
 //!         u16 LE   u16 LE u32 LE       u32 LE front_end | inference | policy | library | rig
+//!                                                | skeleton (optional, host-side)
 //! ```
 //!
 //! `docs/blob-format.md` is the normative description: field meanings and units, the postcard
@@ -29,6 +30,7 @@
 mod crc;
 mod error;
 mod payload;
+mod skeleton;
 mod tables;
 mod validate;
 
@@ -38,9 +40,11 @@ pub use crc::{crc32, Crc32};
 pub use error::{BlobError, Field, Section};
 pub use payload::{
     FrontEndSection, I16Section, InferenceSection, LibrarySection, Payload, PolicySection,
-    RigSection, CALIBRATION_RECORD_BYTES, EXIT_RECORD_BYTES, FRAME_SCALE_RECORD_BYTES,
-    GMM_RECORD_BYTES, NO_STROKE, SUCCESSOR_RECORD_BYTES,
+    RigSection, SkeletonSection, CALIBRATION_RECORD_BYTES, DRIVE_RECORD_BYTES,
+    END_SITE_RECORD_BYTES, EXIT_RECORD_BYTES, FRAME_SCALE_RECORD_BYTES, GMM_RECORD_BYTES,
+    NO_STROKE, ROOT_PARENT, SUCCESSOR_RECORD_BYTES,
 };
+pub use skeleton::{Drive, DriveMode, SkeletonView, EULER_ORDERS, MAX_JOINTS};
 
 use crate::inference::{CrfWeights, GmmComponent, I16Table, MAX_CLUSTERS};
 #[cfg(doc)]
@@ -51,7 +55,7 @@ use crate::rig::ChannelCal;
 /// The first four bytes of every blob.
 pub const MAGIC: [u8; 4] = *b"GSTB";
 /// The format version this runtime reads and the trainer writes.
-pub const FORMAT_VERSION: u16 = 1;
+pub const FORMAT_VERSION: u16 = 2;
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 16;
 
@@ -71,7 +75,7 @@ pub const MAX_FPS: f32 = 1000.0;
 pub struct Header {
     /// Format version ([`FORMAT_VERSION`]).
     pub version: u16,
-    /// Flags (0 in version 1).
+    /// Flags (0: version 2 defines none).
     pub flags: u16,
     /// Payload length in bytes.
     pub payload_len: u32,
@@ -164,6 +168,8 @@ pub struct SectionSizes {
     pub library: usize,
     /// `rig`.
     pub rig: usize,
+    /// `skeleton` (1 byte when absent: postcard's `None`).
+    pub skeleton: usize,
 }
 
 /// An exit point: a frame of a segment where the policy may switch.
@@ -676,6 +682,14 @@ impl<'a> Blob<'a> {
     pub fn channel_names(&self) -> core::str::Split<'a, char> {
         self.payload.rig.channel_names.split('\n')
     }
+
+    // --- skeleton ---
+
+    /// The library's skeleton and the rig channels' drives, if the blob carries them (host
+    /// tools only; validated like every other section).
+    pub fn skeleton(&self) -> Option<SkeletonView<'a>> {
+        self.payload.skeleton.map(SkeletonView::new)
+    }
 }
 
 /// Decodes the sections one after the other, recording their encoded sizes. Postcard encodes a
@@ -697,9 +711,10 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
     let (policy, pol) = take(&mut rest, Section::Policy)?;
     let (library, lib) = take(&mut rest, Section::Library)?;
     let (rig, rg) = take(&mut rest, Section::Rig)?;
+    let (skeleton, sk) = take(&mut rest, Section::Skeleton)?;
     if !rest.is_empty() {
         return Err(BlobError::Malformed {
-            section: Section::Rig,
+            section: Section::Skeleton,
         });
     }
     Ok((
@@ -709,6 +724,7 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
             policy,
             library,
             rig,
+            skeleton,
         },
         SectionSizes {
             front_end: fe,
@@ -716,6 +732,7 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
             policy: pol,
             library: lib,
             rig: rg,
+            skeleton: sk,
         },
     ))
 }

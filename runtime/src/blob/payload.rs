@@ -24,8 +24,15 @@ pub const FRAME_SCALE_RECORD_BYTES: usize = 8;
 pub const CALIBRATION_RECORD_BYTES: usize = 7 * 4;
 /// Segment stroke value meaning "no stroke frame".
 pub const NO_STROKE: u16 = 0xFFFF;
+/// Bytes of one skeleton end-site record (`joint: u16`, then `x, y, z: f32`).
+pub const END_SITE_RECORD_BYTES: usize = 2 + 3 * 4;
+/// Bytes of one skeleton drive record (`joint: u16`, `chain_top: u16`, `axis: u8`, `mode: u8`).
+pub const DRIVE_RECORD_BYTES: usize = 6;
+/// `skeleton.parents` value of a root joint.
+pub const ROOT_PARENT: u16 = 0xFFFF;
 
-/// The whole payload: the five sections in this order.
+/// The whole payload: the five device sections in this order, then the optional host-side
+/// skeleton.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Payload<'a> {
     /// Front-end settings.
@@ -42,6 +49,9 @@ pub struct Payload<'a> {
     /// Output channels and their servo calibration.
     #[serde(borrow)]
     pub rig: RigSection<'a>,
+    /// The library's skeleton, for host tools that rebuild BVH motion (the device ignores it).
+    #[serde(borrow)]
+    pub skeleton: Option<SkeletonSection<'a>>,
 }
 
 /// The prosody front-end's settings ([`ProsodyConfig`], flattened).
@@ -230,4 +240,37 @@ pub struct RigSection<'a> {
     pub calibration: &'a [u8],
     /// Channel names separated by `'\n'`, one per channel.
     pub channel_names: &'a str,
+}
+
+/// The gesture library's BVH skeleton and how the rig's channels drive it: host-side data
+/// (simulator BVH output and previews). The runtime validates it but never reads it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkeletonSection<'a> {
+    /// Joints J, in BVH file (depth-first) order.
+    pub joints: u16,
+    /// J joint names separated by `'\n'`.
+    pub joint_names: &'a str,
+    /// `u16` per joint: parent index, [`ROOT_PARENT`] for a root.
+    pub parents: &'a [u8],
+    /// `3 f32` per joint: BVH `OFFSET` in the parent's frame.
+    #[serde(borrow)]
+    pub offsets: &'a [u8],
+    /// `u8` per joint: its number of BVH channels (0..=6).
+    #[serde(borrow)]
+    pub channel_counts: &'a [u8],
+    /// `u8` per channel, joint after joint in file order: 0..=5 = `Xposition`, `Yposition`,
+    /// `Zposition`, `Xrotation`, `Yrotation`, `Zrotation`.
+    #[serde(borrow)]
+    pub channel_codes: &'a [u8],
+    /// `f32` per channel: the rest pose (first frame of the library's first take), in BVH
+    /// units (degrees, skeleton units).
+    #[serde(borrow)]
+    pub rest: &'a [u8],
+    /// End sites: records `{joint: u16, x: f32, y: f32, z: f32}`, strictly increasing joint.
+    #[serde(borrow)]
+    pub end_sites: &'a [u8],
+    /// One record per rig channel: `{joint: u16, chain_top: u16, axis: u8, mode: u8}` (see
+    /// docs/blob-format.md).
+    #[serde(borrow)]
+    pub drives: &'a [u8],
 }

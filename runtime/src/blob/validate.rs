@@ -1,10 +1,11 @@
 //! Field validation of a decoded payload, in the order of docs/blob-format.md ("Validation"):
 //! front_end, inference, library, rig, policy (the policy indexes into the library, so the
-//! library is checked first). Each check returns the first rule broken; O(payload size), no
+//! library is checked first), then the optional skeleton. Each check returns the first rule broken; O(payload size), no
 //! allocation, no panics (all index arithmetic is checked or bounded by the capacities).
 
 use super::error::{BlobError, Field};
 use super::payload::*;
+use super::skeleton::{Drive, MAX_JOINTS};
 use super::{calibration_from_record, MAX_SEGMENTS};
 use super::{f32_at, record, u16_at, u32_at, MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES};
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
@@ -23,6 +24,9 @@ pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
     library(&p.library)?;
     rig(&p.rig, p.library.channels as usize)?;
     let (u, u_cont) = policy(&p.policy, &p.inference, &p.library)?;
+    if let Some(sk) = &p.skeleton {
+        skeleton(sk, p.library.channels as usize)?;
+    }
     Ok(Validated { crf, u, u_cont })
 }
 
@@ -337,4 +341,117 @@ fn policy<'a>(
         }
     }
     Ok((u, u_cont))
+}
+
+fn all_finite(bytes: &[u8]) -> bool {
+    bytes.chunks_exact(4).all(|c| {
+        c.first_chunk::<4>()
+            .is_some_and(|b| f32::from_le_bytes(*b).is_finite())
+    })
+}
+
+fn skeleton(s: &SkeletonSection<'_>, rig_channels: usize) -> Result<(), BlobError> {
+    let j = s.joints as usize;
+    count(
+        j,
+        MAX_JOINTS,
+        Field::Joints,
+        BlobError::TooManyJoints { found: j as u32 },
+    )?;
+    let names = s.joint_names.split('\n').count();
+    if names != j {
+        return Err(BlobError::JointNameCount {
+            expected: j as u32,
+            found: names as u32,
+        });
+    }
+    length(Field::Parents, s.parents, j, 2)?;
+    length(Field::Offsets, s.offsets, j, 12)?;
+    length(Field::ChannelCounts, s.channel_counts, j, 1)?;
+    let n: usize = s.channel_counts.iter().map(|&c| c as usize).sum();
+    length(Field::ChannelCodes, s.channel_codes, n, 1)?;
+    length(Field::Rest, s.rest, n, 4)?;
+    let sites = s.end_sites.len() / END_SITE_RECORD_BYTES;
+    length(Field::EndSites, s.end_sites, sites, END_SITE_RECORD_BYTES)?;
+    length(Field::Drives, s.drives, rig_channels, DRIVE_RECORD_BYTES)?;
+    if !all_finite(s.offsets) {
+        return Err(BlobError::NotFinite {
+            field: Field::Offsets,
+        });
+    }
+    if !all_finite(s.rest) {
+        return Err(BlobError::NotFinite { field: Field::Rest });
+    }
+    let parent = |k: usize| match u16_at(s.parents, k) {
+        Some(ROOT_PARENT) | None => None,
+        Some(p) => Some(p as usize),
+    };
+    // Depth-first order: each joint's parent precedes it and is the previous joint or one of
+    // its ancestors (the stack rule of a pre-order walk). The walk up is bounded by `k`
+    // because every parent precedes its child.
+    for k in 0..j {
+        let Some(p) = parent(k) else { continue };
+        let mut ok = false;
+        if p < k {
+            let mut cur = Some(k - 1);
+            while let Some(c) = cur {
+                if c <= p {
+                    ok = c == p;
+                    break;
+                }
+                cur = parent(c).filter(|&q| q < c);
+            }
+        }
+        if !ok {
+            return Err(BlobError::BadParent { joint: k as u32 });
+        }
+    }
+    let mut start = 0usize;
+    for (k, &c) in s.channel_counts.iter().enumerate() {
+        let codes = s
+            .channel_codes
+            .get(start..start + c as usize)
+            .unwrap_or(&[]);
+        let bad = c > 6
+            || codes
+                .iter()
+                .enumerate()
+                .any(|(i, &x)| x > 5 || codes[..i].contains(&x));
+        if bad {
+            return Err(BlobError::BadJointChannels { joint: k as u32 });
+        }
+        start += c as usize;
+    }
+    let mut prev: Option<u16> = None;
+    for (i, r) in s.end_sites.chunks_exact(END_SITE_RECORD_BYTES).enumerate() {
+        let joint = u16::from_le_bytes([r[0], r[1]]);
+        if joint as usize >= j || prev.is_some_and(|p| p >= joint) {
+            return Err(BlobError::BadEndSite { entry: i as u32 });
+        }
+        if !all_finite(&r[2..]) {
+            return Err(BlobError::NotFinite {
+                field: Field::EndSites,
+            });
+        }
+        prev = Some(joint);
+    }
+    for ch in 0..rig_channels {
+        let d = record::<DRIVE_RECORD_BYTES>(s.drives, ch).and_then(Drive::from_record);
+        let ok = d.is_some_and(|d| {
+            let (joint, top) = (d.joint as usize, d.chain_top as usize);
+            // The chain top is the joint or one of its ancestors.
+            let mut cur = Some(joint);
+            while let Some(c) = cur {
+                if c == top {
+                    break;
+                }
+                cur = parent(c).filter(|&q| q < c);
+            }
+            joint < j && cur == Some(top)
+        });
+        if !ok {
+            return Err(BlobError::BadDrive { channel: ch as u32 });
+        }
+    }
+    Ok(())
 }

@@ -39,8 +39,8 @@ pub fn summary(b: &Blob<'_>) -> String {
     );
     let _ = writeln!(
         s,
-        "sections (bytes): front_end {}, inference {}, policy {}, library {}, rig {}",
-        z.front_end, z.inference, z.policy, z.library, z.rig
+        "sections (bytes): front_end {}, inference {}, policy {}, library {}, rig {}, skeleton {}",
+        z.front_end, z.inference, z.policy, z.library, z.rig, z.skeleton
     );
     let c = b.prosody_config();
     let _ = writeln!(
@@ -95,5 +95,20 @@ pub fn summary(b: &Blob<'_>) -> String {
         b.channels(),
         names.join(", ")
     );
+    match b.skeleton() {
+        Some(sk) => {
+            let root = sk.joint_name(0).unwrap_or("");
+            let _ = writeln!(
+                s,
+                "skeleton: {} joints (root {root:?}), {} channels per frame (host-side, for BVH \
+                 output)",
+                sk.joints(),
+                sk.channel_count()
+            );
+        }
+        None => {
+            let _ = writeln!(s, "skeleton: none (no BVH output from this blob)");
+        }
+    }
     s
 }

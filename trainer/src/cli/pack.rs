@@ -26,6 +26,9 @@ pub struct PackArgs {
     /// Write the pack report (JSON) here.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Leave out the host-side skeleton section (the simulator then writes no BVH).
+    #[arg(long)]
+    pub no_skeleton: bool,
     /// Corpus loading options (effectors).
     #[command(flatten)]
     pub load: CorpusArgs,
@@ -37,18 +40,21 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         rig: a.rig.clone(),
         budget_bytes: a.budget_bytes,
         effectors: a.load.options().effectors,
+        no_skeleton: a.no_skeleton,
         ..PackOptions::default()
     };
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
     println!(
-        "wrote {}: {} bytes (front-end {}, inference {}, policy {}, library {}, rig {})",
+        "wrote {}: {} bytes (front-end {}, inference {}, policy {}, library {}, rig {}, \
+         skeleton {})",
         a.out.display(),
         r.blob_bytes,
         r.section_bytes.front_end,
         r.section_bytes.inference,
         r.section_bytes.policy,
         r.section_bytes.library,
-        r.section_bytes.rig
+        r.section_bytes.rig,
+        r.section_bytes.skeleton
     );
     println!(
         "library: {} segments, {} exit points, {} frames; rig {} ({} channels)",
