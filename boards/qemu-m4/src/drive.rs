@@ -1,0 +1,302 @@
+//! Drives the runtime's `Controller` over 16 kHz PCM the way a microphone DMA would deliver
+//! it, and writes the decision trace.
+//!
+//! This file is shared, byte for byte, by the firmware (`src/main.rs`) and by the host
+//! reference (`tests/examples/qemu_m4_host.rs` includes it with `#[path]`), so the device and
+//! the desktop run the same loop over the same samples in the same chunks and print the same
+//! lines. Only the CPU differs; CI diffs the two traces.
+//!
+//! ## The trace
+//!
+//! Per input: `input <name> samples=<n>`, then one line per decision
+//!
+//! ```text
+//! decision tick=<t> exit=<e> choice=<continue|segment N>
+//! ```
+//!
+//! and a closing `end` line with counts and FNV-1a hashes of every belief and every pose
+//! (their `f32` bit patterns), so a numeric drift between host and device shows even when no
+//! decision changes.
+//!
+//! ## Checks on the way
+//!
+//! Every pose must be finite; it is driven through the runtime's `ServoRig` (the blob's
+//! calibration, 16-bit recording pins) and every duty cycle must stay within the
+//! 500..=2500 us pulse range. A violation stops the run with [`RunError::Pose`].
+//!
+//! `no_std`, no heap: the controller and the DMA buffer are on the caller's stack.
+
+use core::convert::Infallible;
+use core::fmt::{self, Write};
+
+use embedded_hal::pwm::{ErrorType, SetDutyCycle};
+use gesture_runtime::blob::{Blob, BlobError};
+use gesture_runtime::controller::{Controller, ControllerError, ControllerEvent};
+use gesture_runtime::policy::Choice;
+use gesture_runtime::rig::{
+    duty_cycle, ChannelCal, RigError, ServoRig, PULSE_MAX_US, PULSE_MIN_US,
+};
+
+/// Samples per DMA buffer (16 ms at 16 kHz).
+pub const CHUNK: usize = 256;
+/// Sample rate of the embedded audio.
+pub const AUDIO_RATE_HZ: u32 = 16_000;
+/// Servo channels of the board (the puppet rig, `rigs/puppet-8ch.toml`).
+pub const CHANNELS: usize = 8;
+
+/// The controller over a blob's tables, as [`run`] builds it.
+pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
+
+/// Why a run stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RunError {
+    /// The blob was refused.
+    Blob(BlobError),
+    /// The blob's front-end runs at another rate than the audio.
+    SampleRate {
+        /// The blob's rate (Hz).
+        found: u32,
+    },
+    /// The blob drives another number of servos than the board has.
+    Channels {
+        /// The blob's channel count.
+        found: usize,
+    },
+    /// The controller refused the blob's tables.
+    Controller(ControllerError),
+    /// The servo rig refused the blob's calibration.
+    Rig(RigError),
+    /// The audio is not whole 16-bit samples.
+    OddAudio {
+        /// Its length in bytes.
+        len: usize,
+    },
+    /// A pose was not finite, or a servo pulse left 500..=2500 us.
+    Pose {
+        /// The animation tick.
+        tick: u64,
+    },
+    /// Writing the trace failed.
+    Output,
+}
+
+impl fmt::Display for RunError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Blob(e) => write!(f, "blob: {e}"),
+            Self::SampleRate { found } => write!(
+                f,
+                "blob front-end runs at {found} Hz, the audio at {AUDIO_RATE_HZ} Hz"
+            ),
+            Self::Channels { found } => write!(
+                f,
+                "blob drives {found} channels, this board has {CHANNELS} servos"
+            ),
+            Self::Controller(e) => write!(f, "controller: {e}"),
+            Self::Rig(e) => write!(f, "servo rig: {e}"),
+            Self::OddAudio { len } => write!(f, "audio is {len} bytes, not whole i16 samples"),
+            Self::Pose { tick } => write!(f, "invalid pose or servo pulse at tick {tick}"),
+            Self::Output => f.write_str("writing the trace failed"),
+        }
+    }
+}
+
+/// Measurement hooks (the firmware's `measure` build times the controller with them).
+/// Every method defaults to nothing.
+pub trait Probe {
+    /// Just before a DMA buffer is handed to the controller.
+    fn chunk_begin(&mut self) {}
+    /// Just after the controller returned from a buffer.
+    fn chunk_end(&mut self) {}
+    /// On entry to the event sink, before the event is handled.
+    fn event_begin(&mut self, _event: &ControllerEvent<'_>) {}
+    /// On leaving the event sink.
+    fn event_end(&mut self) {}
+}
+
+/// No measurement.
+#[allow(dead_code)] // not used by the firmware's `measure` build
+pub struct NoProbe;
+
+impl Probe for NoProbe {}
+
+/// What a run saw.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Summary {
+    /// Samples fed.
+    pub samples: u64,
+    /// Prosody frames.
+    pub frames: u64,
+    /// Steps (syllables and pauses).
+    pub steps: u64,
+    /// Decisions.
+    pub decisions: u64,
+    /// Animation ticks (poses).
+    pub ticks: u64,
+    /// FNV-1a over every belief's bits.
+    pub belief_hash: u32,
+    /// FNV-1a over every pose's bits.
+    pub pose_hash: u32,
+    /// Shortest and longest servo pulse commanded (duty steps of a 16-bit timer).
+    pub duty_range: (u16, u16),
+}
+
+/// A servo output that keeps the last duty cycle (a 16-bit timer channel).
+#[derive(Clone, Copy, Debug, Default)]
+struct RecordingPin {
+    duty: u16,
+}
+
+impl ErrorType for RecordingPin {
+    type Error = Infallible;
+}
+
+impl SetDutyCycle for RecordingPin {
+    fn max_duty_cycle(&self) -> u16 {
+        u16::MAX
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
+        self.duty = duty;
+        Ok(())
+    }
+}
+
+const FNV_OFFSET: u32 = 0x811c_9dc5;
+
+fn fnv(mut h: u32, values: &[f32]) -> u32 {
+    for v in values {
+        for b in v.to_bits().to_le_bytes() {
+            h ^= b as u32;
+            h = h.wrapping_mul(0x0100_0193);
+        }
+    }
+    h
+}
+
+/// Runs a fresh controller from `blob` over `audio` (little-endian i16 at 16 kHz) in
+/// [`CHUNK`]-sample buffers, writing the trace for input `name` to `out`.
+pub fn run(
+    name: &str,
+    blob: &[u8],
+    audio: &[u8],
+    out: &mut impl Write,
+    probe: &mut impl Probe,
+) -> Result<Summary, RunError> {
+    let blob = Blob::parse(blob).map_err(RunError::Blob)?;
+    let config = blob.prosody_config();
+    if config.sample_rate_hz != AUDIO_RATE_HZ {
+        return Err(RunError::SampleRate {
+            found: config.sample_rate_hz,
+        });
+    }
+    if blob.channels() != CHANNELS {
+        return Err(RunError::Channels {
+            found: blob.channels(),
+        });
+    }
+    if audio.len() % 2 != 0 {
+        return Err(RunError::OddAudio { len: audio.len() });
+    }
+    let mut cals = [ChannelCal::HOBBY; CHANNELS];
+    for (ch, cal) in cals.iter_mut().enumerate() {
+        // Validated with the blob: every channel has a calibration.
+        *cal = blob.calibration(ch).ok_or(RunError::Channels {
+            found: blob.channels(),
+        })?;
+    }
+    let period_us = blob.period_us();
+    let mut rig = ServoRig::new([RecordingPin::default(); CHANNELS], cals, period_us)
+        .map_err(RunError::Rig)?;
+    let _ = rig.neutral();
+    let duty_min = duty_cycle(PULSE_MIN_US, period_us, u16::MAX);
+    let duty_max = duty_cycle(PULSE_MAX_US, period_us, u16::MAX);
+    let dt_s = 1.0 / blob.fps();
+
+    let gmm = blob.gmm();
+    let mut controller: BlobController<'_> =
+        Controller::new(&config, gmm.as_slice(), blob.crf_weights(), &blob, &blob)
+            .map_err(RunError::Controller)?;
+
+    writeln!(out, "input {name} samples={}", audio.len() / 2).map_err(|_| RunError::Output)?;
+    let mut sum = Summary {
+        belief_hash: FNV_OFFSET,
+        pose_hash: FNV_OFFSET,
+        duty_range: (u16::MAX, 0),
+        ..Summary::default()
+    };
+    let mut failure: Option<RunError> = None;
+    // The DMA buffer: samples land here in RAM before the controller sees them.
+    let mut dma = [0i16; CHUNK];
+    for bytes in audio.chunks(2 * CHUNK) {
+        let n = bytes.len() / 2;
+        for (s, b) in dma.iter_mut().zip(bytes.chunks_exact(2)) {
+            *s = i16::from_le_bytes([b[0], b[1]]);
+        }
+        probe.chunk_begin();
+        controller.push(&dma[..n], &mut |ev| {
+            probe.event_begin(&ev);
+            match ev {
+                ControllerEvent::Frame(_) => sum.frames += 1,
+                ControllerEvent::Step { belief, .. } => {
+                    sum.steps += 1;
+                    sum.belief_hash = fnv(sum.belief_hash, belief);
+                }
+                ControllerEvent::Decision { tick, decision } => {
+                    sum.decisions += 1;
+                    let written = match decision.choice {
+                        Choice::Continue => writeln!(
+                            out,
+                            "decision tick={tick} exit={} choice=continue",
+                            decision.exit
+                        ),
+                        Choice::Enter(c) => writeln!(
+                            out,
+                            "decision tick={tick} exit={} choice=segment {c}",
+                            decision.exit
+                        ),
+                    };
+                    if written.is_err() && failure.is_none() {
+                        failure = Some(RunError::Output);
+                    }
+                }
+                ControllerEvent::Pose { tick, pose } => {
+                    sum.ticks += 1;
+                    sum.pose_hash = fnv(sum.pose_hash, pose);
+                    let _ = rig.apply(pose, dt_s);
+                    let mut ok = pose.iter().all(|v| v.is_finite());
+                    for pin in rig.pins() {
+                        ok &= (duty_min..=duty_max).contains(&pin.duty);
+                        sum.duty_range.0 = sum.duty_range.0.min(pin.duty);
+                        sum.duty_range.1 = sum.duty_range.1.max(pin.duty);
+                    }
+                    if !ok && failure.is_none() {
+                        failure = Some(RunError::Pose { tick });
+                    }
+                }
+            }
+            probe.event_end();
+        });
+        probe.chunk_end();
+        sum.samples += n as u64;
+        if let Some(e) = failure {
+            return Err(e);
+        }
+    }
+    writeln!(
+        out,
+        "end samples={} frames={} steps={} decisions={} ticks={} belief_hash={:08x} \
+         pose_hash={:08x} duty={}..{}",
+        sum.samples,
+        sum.frames,
+        sum.steps,
+        sum.decisions,
+        sum.ticks,
+        sum.belief_hash,
+        sum.pose_hash,
+        sum.duty_range.0,
+        sum.duty_range.1
+    )
+    .map_err(|_| RunError::Output)?;
+    Ok(sum)
+}

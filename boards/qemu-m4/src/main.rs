@@ -1,0 +1,174 @@
+//! Firmware for QEMU's `mps2-an386` (Cortex-M4F): the gesture-controller runtime on the
+//! device, fed from flash as a microphone DMA would feed it.
+//!
+//! It embeds a policy blob and two 16 kHz inputs made by `make-assets` (`assets/`, not in
+//! git): `speech` (a held-out synthetic take) and `stress` (silence, clipped speech, white
+//! noise, full-scale square wave). For each it runs a fresh `Controller` over the samples in
+//! 256-sample buffers ([`drive`], shared with the host reference) and prints the decision trace
+//! on semihosting stdout. On stderr it prints the peak stack (the stack is painted by
+//! `cortex-m-rt` before `main`; the lowest scrubbed word is the peak).
+//!
+//! Exit status (semihosting `SYS_EXIT`): 0 when every input ran with valid poses; 1 on any
+//! error (blob refused, invalid pose, output failure), panic or fault.
+//!
+//! With the `measure` feature it also times the controller with SysTick under
+//! `qemu -icount shift=0` and prints `measure` lines for `report` ([`measure`]).
+#![no_std]
+#![no_main]
+
+mod drive;
+#[cfg(feature = "measure")]
+mod measure;
+
+use core::fmt::{self, Write};
+
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_semihosting::{debug, hio};
+
+/// The policy blob (`assets/policy.blob`).
+static BLOB: &[u8] = include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/policy.blob"));
+
+/// The inputs, little-endian i16 at 16 kHz, in the order they run.
+static INPUTS: [(&str, &[u8]); 2] = [
+    (
+        "speech",
+        include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/speech.raw")),
+    ),
+    (
+        "stress",
+        include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/stress.raw")),
+    ),
+];
+
+/// Semihosting output in whole lines: one `SYS_WRITE` per line instead of one per fragment.
+struct HostLines {
+    stream: Option<hio::HostStream>,
+    buf: [u8; 160],
+    len: usize,
+}
+
+impl HostLines {
+    fn new(stream: Result<hio::HostStream, ()>) -> Self {
+        Self {
+            stream: stream.ok(),
+            buf: [0; 160],
+            len: 0,
+        }
+    }
+
+    fn flush(&mut self) -> fmt::Result {
+        let n = core::mem::take(&mut self.len);
+        match &mut self.stream {
+            Some(s) => s.write_all(&self.buf[..n]).map_err(|()| fmt::Error),
+            None => Err(fmt::Error),
+        }
+    }
+}
+
+impl Write for HostLines {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        for &b in s.as_bytes() {
+            if self.len == self.buf.len() {
+                self.flush()?;
+            }
+            self.buf[self.len] = b;
+            self.len += 1;
+            if b == b'\n' {
+                self.flush()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+fn exit(ok: bool) -> ! {
+    debug::exit(if ok {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    // Only reached without a semihosting host: stop with a fault.
+    cortex_m::asm::udf()
+}
+
+/// Bytes of stack ever used: from the top of RAM down to the lowest word that no longer holds
+/// the paint.
+fn peak_stack_bytes() -> usize {
+    extern "C" {
+        static _stack_start: u32;
+        static _stack_end: u32;
+    }
+    // SAFETY: both symbols come from cortex-m-rt's linker script and bound the stack region,
+    // which is RAM; it is read word by word (aligned, in range) below the live stack frame.
+    unsafe {
+        let top = core::ptr::addr_of!(_stack_start) as usize;
+        let mut p = core::ptr::addr_of!(_stack_end);
+        while (p as usize) < top && core::ptr::read_volatile(p) == cortex_m_rt::STACK_PAINT_VALUE {
+            p = p.add(1);
+        }
+        top - p as usize
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let mut out = HostLines::new(hio::hstdout());
+    let mut err = HostLines::new(hio::hstderr());
+    #[cfg(feature = "measure")]
+    let mut clock = measure::Clock::start();
+    #[cfg(feature = "measure")]
+    measure::calibrate(&mut clock, &mut out);
+    #[cfg(feature = "measure")]
+    measure::blob_parse(&mut clock, BLOB, &mut out);
+
+    let mut ok = true;
+    for (name, audio) in INPUTS.iter() {
+        #[cfg(not(feature = "measure"))]
+        let result = drive::run(name, BLOB, audio, &mut out, &mut drive::NoProbe);
+        #[cfg(feature = "measure")]
+        let result = {
+            let mut probe = measure::Timing::new(&mut clock);
+            let r = drive::run(name, BLOB, audio, &mut out, &mut probe);
+            if let Ok(sum) = &r {
+                probe.report(name, sum, &mut out);
+            }
+            r
+        };
+        if let Err(e) = result {
+            // Debug, not Display: the blob error's Display formats an f32 limit, which would
+            // link about 15 KiB of float formatting into the firmware.
+            let _ = writeln!(err, "error: input {name}: {e:?}");
+            ok = false;
+            break;
+        }
+    }
+    let _ = writeln!(
+        err,
+        "memory peak_stack_bytes={} controller_bytes={} blob_bytes={}",
+        peak_stack_bytes(),
+        core::mem::size_of::<drive::BlobController<'static>>(),
+        BLOB.len()
+    );
+    exit(ok)
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    let mut err = HostLines::new(hio::hstderr());
+    let _ = writeln!(err, "panic: {info}");
+    exit(false)
+}
+
+#[exception]
+unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
+    let mut err = HostLines::new(hio::hstderr());
+    let _ = writeln!(err, "hard fault at pc={:#010x}", frame.pc());
+    exit(false)
+}
+
+#[exception]
+unsafe fn DefaultHandler(irqn: i16) {
+    let mut err = HostLines::new(hio::hstderr());
+    let _ = writeln!(err, "unexpected exception {irqn}");
+    exit(false)
+}

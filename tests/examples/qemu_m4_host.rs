@@ -1,0 +1,154 @@
+//! The host side of the QEMU Cortex-M4F check (`boards/qemu-m4`).
+//!
+//! - `audio --wav TAKE.wav --seconds S --out DIR` writes the firmware's two inputs as raw
+//!   little-endian i16 at 16 kHz: `DIR/speech.raw` (the first `S` seconds of the take) and
+//!   `DIR/stress.raw` (the same length in four equal parts: digital silence, the speech
+//!   amplified 16x into hard clipping, full-scale white noise from a fixed seed, and a
+//!   full-scale 200 Hz square wave from `i16::MIN` to `i16::MAX`).
+//! - `trace --blob BLOB --input NAME=FILE ...` prints the reference decision trace: the
+//!   firmware's own drive loop (`boards/qemu-m4/src/drive.rs`, included below) over the same
+//!   samples in the same 256-sample chunks, so its output must equal the firmware's stdout
+//!   byte for byte.
+//!
+//! Exit status: 0 on success, 1 on any error (one line on stderr naming the file).
+
+#[path = "../../boards/qemu-m4/src/drive.rs"]
+mod drive;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "qemu_m4_host",
+    about = "Inputs and reference trace for boards/qemu-m4"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Write speech.raw and stress.raw from a WAV take.
+    Audio {
+        /// The take (any WAV the trainer reads; converted to 16 kHz mono).
+        #[arg(long)]
+        wav: PathBuf,
+        /// Seconds to keep from the start of the take.
+        #[arg(long, default_value_t = 6.0)]
+        seconds: f64,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Print the decision trace the firmware must print.
+    Trace {
+        /// The policy blob.
+        #[arg(long)]
+        blob: PathBuf,
+        /// `NAME=FILE`: an input (raw i16 LE, 16 kHz), in the firmware's order.
+        #[arg(long = "input", required = true)]
+        inputs: Vec<String>,
+    },
+}
+
+fn read(path: &Path) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn write_raw(path: &Path, samples: &[i16]) -> Result<(), String> {
+    let bytes: Vec<u8> = samples.iter().flat_map(|s| s.to_le_bytes()).collect();
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// The stress input: silence, clipping, white noise and a full-scale square wave, each a
+/// quarter of `speech`'s length.
+fn stress(speech: &[i16]) -> Vec<i16> {
+    let quarter = speech.len() / 4;
+    let mut out = Vec::with_capacity(speech.len());
+    out.extend(std::iter::repeat_n(0i16, quarter));
+    // The loudest quarter of the speech, amplified into the rails.
+    let loud = (0..4)
+        .map(|q| &speech[q * quarter..(q + 1) * quarter])
+        .max_by_key(|s| s.iter().map(|&v| (v as i64).abs()).sum::<i64>())
+        .unwrap_or(&[]);
+    out.extend(
+        loud.iter()
+            .map(|&v| (v as i32 * 16).clamp(i16::MIN as i32, i16::MAX as i32) as i16),
+    );
+    // xorshift32 with a fixed seed: uniform over the whole i16 range.
+    let mut x = 0x2545_f491u32;
+    out.extend((0..quarter).map(|_| {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        (x >> 16) as u16 as i16
+    }));
+    // 200 Hz at 16 kHz: 40 samples per half period.
+    out.extend((0..speech.len() - out.len()).map(|i| {
+        if (i / 40) % 2 == 0 {
+            i16::MAX
+        } else {
+            i16::MIN
+        }
+    }));
+    out
+}
+
+fn audio(wav: &Path, seconds: f64, out: &Path) -> Result<(), String> {
+    let pcm = gesture_trainer::audio::load_wav_at(wav, drive::AUDIO_RATE_HZ)
+        .map_err(|e| e.to_string())?;
+    let n = ((seconds * drive::AUDIO_RATE_HZ as f64) as usize).min(pcm.samples.len());
+    let speech = &pcm.samples[..n];
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    write_raw(&out.join("speech.raw"), speech)?;
+    write_raw(&out.join("stress.raw"), &stress(speech))
+}
+
+fn trace(blob: &Path, inputs: &[String]) -> Result<(), String> {
+    let blob_bytes = read(blob)?;
+    for input in inputs {
+        let (name, file) = input
+            .split_once('=')
+            .ok_or_else(|| format!("--input {input}: expected NAME=FILE"))?;
+        let audio = read(Path::new(file))?;
+        let mut text = String::new();
+        let result = drive::run(name, &blob_bytes, &audio, &mut text, &mut drive::NoProbe);
+        print!("{text}");
+        result.map_err(|e| format!("input {name} ({file}, blob {}): {e}", blob.display()))?;
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Audio { wav, seconds, out } => audio(wav, *seconds, out),
+        Command::Trace { blob, inputs } => trace(blob, inputs),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("qemu_m4_host: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stress_has_the_four_parts() {
+        let speech: Vec<i16> = (0..16_000).map(|i| ((i % 100) * 50) as i16).collect();
+        let s = stress(&speech);
+        assert_eq!(s.len(), speech.len());
+        assert!(s[..4000].iter().all(|&v| v == 0));
+        assert!(s[4000..8000].contains(&i16::MAX));
+        assert!(s[12_000..].contains(&i16::MIN));
+    }
+}
