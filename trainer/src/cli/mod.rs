@@ -3,6 +3,7 @@
 //! one line, and the binary exits with status 2 on any error.
 
 pub mod eval_inference;
+pub mod eval_motion;
 pub mod fit;
 pub mod inspect;
 pub mod pack;
@@ -35,6 +36,8 @@ pub enum Command {
     EvalInference(eval_inference::EvalArgs),
     /// Pack a model, a gesture library and a rig into a policy blob.
     Pack(pack::PackArgs),
+    /// Motion quality of the online policy on held-out audio vs random, offline DP, mocap.
+    EvalMotion(eval_motion::EvalMotionArgs),
     /// Validate a policy blob and summarize it: header, section sizes, dimensions, rig.
     Inspect(inspect::InspectArgs),
 }
@@ -113,6 +116,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Fit(a) => fit::run(&a),
         Command::EvalInference(a) => eval_inference::run(&a),
         Command::Pack(a) => pack::run(&a),
+        Command::EvalMotion(a) => eval_motion::run(&a),
         Command::Inspect(a) => inspect::run(&a),
     }
 }

@@ -14,21 +14,22 @@ use super::mdp::{Action, Policy};
 /// A chosen sequence: `(frame, exit point, action)` at every decision.
 pub type Plan = Vec<(usize, usize, Action)>;
 
-/// Best sequence for an utterance of `frames` motion frames, starting at exit `start`;
-/// `post(t)` is the state posterior at frame `t`.
+/// Best sequence for an utterance of `frames` motion frames, standing at exit `start` at
+/// frame `t0`; `post(t)` is the state posterior at frame `t`.
 pub fn best_sequence(
     lib: &Library,
     policy: &Policy,
     psi: &[Vec<f64>],
     frames: usize,
     start: usize,
+    t0: usize,
     post: &dyn Fn(usize) -> Vec<f64>,
 ) -> (f64, Plan) {
     let n_exit = lib.exits.len();
     // cost[t][e]: best cost to stand at exit e at frame t; back pointers for the plan.
     let mut cost = vec![vec![f64::INFINITY; n_exit]; frames + 1];
     let mut back: Vec<Vec<Option<(usize, usize, Action)>>> = vec![vec![None; n_exit]; frames + 1];
-    cost[0][start] = 0.0;
+    cost[t0.min(frames)][start] = 0.0;
     // Best complete sequence: (cost, frame, exit, final action crossing the end).
     let mut best_end: (f64, usize, usize, Option<Action>) = (f64::INFINITY, 0, start, None);
     for t in 0..=frames {

@@ -18,6 +18,7 @@ pub mod dp;
 pub mod library;
 pub mod mdp;
 pub mod prune;
+pub mod quality;
 
 pub use library::{ExitPoint, LibSegment, Library};
 pub use mdp::{Action, MdpParams, Policy};
@@ -153,7 +154,7 @@ mod tests {
         };
         let frames = 300;
         let start = lib.exits.len() - 1;
-        let (dp_cost, plan) = dp::best_sequence(&lib, &pol, &psi, frames, start, &post);
+        let (dp_cost, plan) = dp::best_sequence(&lib, &pol, &psi, frames, start, 0, &post);
         assert!(!plan.is_empty());
         // Greedy online play with the same beliefs, same cost accounting.
         let (mut t, mut e, mut greedy) = (0usize, start, 0.0);

@@ -157,6 +157,12 @@ impl Crf {
         post
     }
 
+    /// Offline posteriors `P(q_t | x_1..T)` (forward-backward over the whole sequence): what
+    /// the offline reference may use, seeing the future.
+    pub fn posteriors(&self, m: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        self.marginals(m).gamma
+    }
+
     /// Online beliefs: the normalized forward vector after each step.
     pub fn beliefs(&self, m: &[Vec<f64>]) -> Vec<Vec<f64>> {
         let s = self.states;
