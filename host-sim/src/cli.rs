@@ -17,6 +17,8 @@ use gesture_runtime::prosody::ConfigError;
 use gesture_trainer::audio::AudioError;
 
 use crate::eval::ParseError;
+use crate::live::{self, LiveError, LiveOptions};
+use crate::run::{self as run_cmd, RunConfig, RunError};
 use crate::{bench, eval_cmd, prosody_cmd};
 
 /// Runs the gesture-controller runtime on the desktop.
@@ -61,6 +63,51 @@ pub enum Command {
         #[arg(long, value_name = "FILE")]
         wav: Option<PathBuf>,
     },
+    /// Run a policy blob on a WAV file and write motion.bvh, timeline.json, servo.csv and
+    /// previews into a folder.
+    Run {
+        /// Policy blob (from `gesture-train pack`).
+        #[arg(long, value_name = "BLOB")]
+        blob: PathBuf,
+        /// Speech audio (any common WAV; resampled to the blob's rate).
+        #[arg(long, value_name = "WAV")]
+        audio: PathBuf,
+        /// Output folder (created if needed).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Rig file whose servo calibration replaces the blob's (same channel names).
+        #[arg(long, value_name = "RIG")]
+        rig: Option<PathBuf>,
+        /// Pace the simulation in real time instead of running as fast as possible.
+        #[arg(long)]
+        realtime: bool,
+        /// Audio chunk length in ms (how often the device would process samples).
+        #[arg(long, default_value_t = 10.0, value_parser = parse_chunk_ms)]
+        chunk_ms: f64,
+    },
+    /// List the audio input devices.
+    Devices,
+    /// Run a policy blob on the microphone, printing decisions and the belief.
+    Live {
+        /// Policy blob (from `gesture-train pack`).
+        #[arg(long, value_name = "BLOB")]
+        blob: PathBuf,
+        /// Input device name (see `gesture-sim devices`) [default: the default input].
+        #[arg(long, value_name = "NAME")]
+        device: Option<String>,
+        /// Stop after this many seconds of audio.
+        #[arg(long, value_parser = parse_seconds)]
+        seconds: Option<f64>,
+    },
+}
+
+fn parse_chunk_ms(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && (0.1..=1000.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err("must be between 0.1 and 1000".into())
+    }
 }
 
 fn parse_seconds(s: &str) -> Result<f64, String> {
@@ -100,6 +147,18 @@ pub enum CliError {
     /// Writing the output failed.
     #[error("writing output: {0}")]
     Output(#[from] io::Error),
+    /// `run` failed (boxed: rig errors are large).
+    #[error(transparent)]
+    Run(Box<RunError>),
+    /// `live` or `devices` failed.
+    #[error(transparent)]
+    Live(#[from] LiveError),
+}
+
+impl From<RunError> for CliError {
+    fn from(e: RunError) -> Self {
+        Self::Run(Box::new(e))
+    }
 }
 
 impl CliError {
@@ -108,6 +167,8 @@ impl CliError {
         match self {
             Self::Audio(_) | Self::Read { .. } | Self::Data { .. } => 2,
             Self::Config(_) | Self::Output(_) => 1,
+            Self::Run(e) => e.exit_code(),
+            Self::Live(e) => e.exit_code(),
         }
     }
 }
@@ -119,6 +180,44 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), CliError> {
         Command::EvalProsody { data, json } => eval_cmd::run(data.as_deref(), *json, out),
         Command::BenchProsody { seconds, runs, wav } => {
             bench::run(*seconds, *runs, wav.as_deref(), out)
+        }
+        Command::Run {
+            blob,
+            audio,
+            out: dir,
+            rig,
+            realtime,
+            chunk_ms,
+        } => run_cmd::run(
+            &RunConfig {
+                blob: blob.clone(),
+                audio: audio.clone(),
+                out: dir.clone(),
+                rig: rig.clone(),
+                realtime: *realtime,
+                chunk_ms: *chunk_ms,
+            },
+            out,
+        ),
+        Command::Devices => Ok(live::devices(out)?),
+        Command::Live {
+            blob,
+            device,
+            seconds,
+        } => {
+            let bytes = run_cmd::read_blob(blob)?;
+            let b =
+                gesture_runtime::blob::Blob::parse(&bytes).map_err(|source| RunError::Blob {
+                    path: blob.clone(),
+                    source,
+                })?;
+            let mut source = live::CpalSource::open(device.as_deref())?;
+            let opts = LiveOptions {
+                seconds: *seconds,
+                redraw: io::IsTerminal::is_terminal(&io::stdout()),
+            };
+            live::live_loop(&b, &mut source, opts, out)?;
+            Ok(())
         }
     }
 }

@@ -13,6 +13,12 @@
 //!   of `shared/tools/prosody_compare.py`, syllable counts).
 //! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
 //! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
+//! - [`run`](mod@run): `gesture-sim run`: a WAV file through the runtime's `Controller`, with
+//!   BVH, timeline, servo trace and previews written to a folder.
+//! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
+//!   [`live::AudioSource`] trait, with a fake source for tests.
+//! - [`servo`]: virtual PWM pins under the runtime's `ServoRig`.
+//! - [`skeleton`]: rig poses back on the library's skeleton (the blob's skeleton section).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -20,4 +26,8 @@ pub mod bench;
 pub mod cli;
 pub mod eval;
 pub mod eval_cmd;
+pub mod live;
 pub mod prosody_cmd;
+pub mod run;
+pub mod servo;
+pub mod skeleton;

@@ -1,0 +1,565 @@
+//! `gesture-sim live` and `gesture-sim devices`: the microphone through the runtime's
+//! `Controller`, printing decisions and a live belief bar.
+//!
+//! The audio path is behind [`AudioSource`]: [`CpalSource`] reads a microphone through cpal
+//! (any sample format, mixed to mono), [`FakeSource`] plays samples from memory and can inject
+//! a failure, so the whole live loop ([`live_loop`]) is tested without hardware. Samples are
+//! resampled to the blob's front-end rate with a streaming band-limited resampler
+//! ([`StreamResampler`], rubato's asynchronous sinc, 128 taps: about 1.3 ms of delay at 48 kHz)
+//! and converted to `i16` as the WAV path does (scale by 32768, round, clamp).
+//!
+//! **Real-time safety.** cpal calls its data callback on an audio thread: the callback only
+//! mixes to mono into a fresh buffer and `try_send`s it on a bounded channel (a full channel
+//! drops the block and counts it, rather than blocking the audio thread). Everything else (the
+//! resampler, the controller, printing) runs on the calling thread.
+//!
+//! **No device.** With no input device (as on a headless server), `live` and `devices` fail
+//! with one line naming what is missing and exit status 2. ALSA's own diagnostics (which it
+//! would print to stderr while probing cards) are captured and dropped on Linux.
+
+use std::io::Write;
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, TrySendError};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use gesture_runtime::blob::Blob;
+use gesture_runtime::controller::{Controller, ControllerEvent};
+use gesture_runtime::policy::Choice;
+use gesture_runtime::prosody::StepKind;
+use rubato::audioadapter_buffers::direct::SequentialSliceOfSlices;
+use rubato::{Async, FixedAsync, Resampler, SincInterpolationParameters, WindowFunction};
+
+/// Why the live path failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LiveError {
+    /// There is no audio input device at all.
+    #[error("no audio input device found (connect a microphone, or use `gesture-sim run` on a WAV file)")]
+    NoDevice,
+    /// The named device does not exist.
+    #[error("no input device named {name:?}; available: {available} (see `gesture-sim devices`)")]
+    DeviceNotFound {
+        /// What was asked for.
+        name: String,
+        /// What there is.
+        available: String,
+    },
+    /// The audio backend failed (opening, configuring or running the stream).
+    #[error("audio input: {0}")]
+    Backend(String),
+    /// The source's sample rate cannot be resampled to the blob's.
+    #[error("cannot resample {from} Hz to {to} Hz: {reason}")]
+    Resample {
+        /// Source rate.
+        from: u32,
+        /// Blob rate.
+        to: u32,
+        /// Why.
+        reason: String,
+    },
+    /// Writing to stdout failed.
+    #[error("writing output: {0}")]
+    Output(#[from] std::io::Error),
+}
+
+impl LiveError {
+    /// Exit status: 2 for a missing or failing device, 1 for output errors.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Output(_) => 1,
+            _ => 2,
+        }
+    }
+}
+
+/// Where live audio comes from.
+pub trait AudioSource {
+    /// Rate (Hz) of the samples [`AudioSource::read`] delivers.
+    fn rate_hz(&self) -> u32;
+    /// Appends the next mono samples (full scale +-1) to `out`, waiting at most `timeout`
+    /// for them (appending nothing on a timeout). `Ok(false)` when the source has ended.
+    fn read(&mut self, out: &mut Vec<f32>, timeout: Duration) -> Result<bool, LiveError>;
+}
+
+/// Samples from memory, `block` at a time; optionally fails after `fail_after` reads.
+#[derive(Clone, Debug)]
+pub struct FakeSource {
+    samples: Vec<f32>,
+    rate_hz: u32,
+    block: usize,
+    pos: usize,
+    reads: usize,
+    fail_after: Option<usize>,
+}
+
+impl FakeSource {
+    /// A source playing `samples` at `rate_hz`, `block` samples per read.
+    pub fn new(samples: Vec<f32>, rate_hz: u32, block: usize) -> Self {
+        Self {
+            samples,
+            rate_hz,
+            block: block.max(1),
+            pos: 0,
+            reads: 0,
+            fail_after: None,
+        }
+    }
+
+    /// The same source, failing like an unplugged device after `reads` successful reads.
+    pub fn failing_after(mut self, reads: usize) -> Self {
+        self.fail_after = Some(reads);
+        self
+    }
+}
+
+impl AudioSource for FakeSource {
+    fn rate_hz(&self) -> u32 {
+        self.rate_hz
+    }
+
+    fn read(&mut self, out: &mut Vec<f32>, _timeout: Duration) -> Result<bool, LiveError> {
+        if self.fail_after.is_some_and(|n| self.reads >= n) {
+            return Err(LiveError::Backend("device unplugged (injected)".into()));
+        }
+        self.reads += 1;
+        if self.pos >= self.samples.len() {
+            return Ok(false);
+        }
+        let end = (self.pos + self.block).min(self.samples.len());
+        out.extend_from_slice(&self.samples[self.pos..end]);
+        self.pos = end;
+        Ok(true)
+    }
+}
+
+/// Streaming resampler to the blob's rate (identity when the rates match).
+pub struct StreamResampler {
+    inner: Option<Async<f32>>,
+    pending: Vec<f32>,
+}
+
+impl StreamResampler {
+    /// From `from` Hz to `to` Hz.
+    pub fn new(from: u32, to: u32) -> Result<Self, LiveError> {
+        if from == to {
+            return Ok(Self {
+                inner: None,
+                pending: Vec::new(),
+            });
+        }
+        let err = |reason: String| LiveError::Resample { from, to, reason };
+        if from == 0 || to == 0 {
+            return Err(err("a rate is 0".into()));
+        }
+        let params = SincInterpolationParameters::new(128, WindowFunction::BlackmanHarris2)
+            .oversampling_factor(128);
+        let chunk = (from as usize / 100).max(16);
+        let r = Async::<f32>::new_sinc(
+            to as f64 / from as f64,
+            1.0,
+            &params,
+            chunk,
+            1,
+            FixedAsync::Input,
+        )
+        .map_err(|e| err(e.to_string()))?;
+        Ok(Self {
+            inner: Some(r),
+            pending: Vec::new(),
+        })
+    }
+
+    /// Feeds `input`; appends every output sample ready so far to `out`.
+    pub fn push(&mut self, input: &[f32], out: &mut Vec<f32>) -> Result<(), LiveError> {
+        let Some(r) = &mut self.inner else {
+            out.extend_from_slice(input);
+            return Ok(());
+        };
+        self.pending.extend_from_slice(input);
+        loop {
+            let need = r.input_frames_next();
+            if self.pending.len() < need {
+                return Ok(());
+            }
+            let chans = [&self.pending[..need]];
+            let adapter = SequentialSliceOfSlices::new(&chans, 1, need)
+                .map_err(|e| LiveError::Backend(e.to_string()))?;
+            let o = r
+                .process(&adapter, None)
+                .map_err(|e| LiveError::Backend(e.to_string()))?;
+            out.extend(o.take_data());
+            self.pending.drain(..need);
+        }
+    }
+}
+
+/// Full scale +-1 to `i16` (round, clamp, non-finite to 0), as the WAV loader does.
+pub fn to_i16(x: f32) -> i16 {
+    if !x.is_finite() {
+        return 0;
+    }
+    (x * 32768.0).round().clamp(-32768.0, 32767.0) as i16
+}
+
+/// A one-line picture of a belief: one block character per state, then the top state.
+pub fn belief_bar(b: &[f32]) -> String {
+    const BLOCKS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
+    let mut s: String = b
+        .iter()
+        .map(|&v| BLOCKS[((v.clamp(0.0, 1.0) * 7.0).round() as usize).min(7)])
+        .collect();
+    if let Some((i, p)) = b.iter().enumerate().max_by(|x, y| x.1.total_cmp(y.1)) {
+        s.push_str(&format!("  top state {i} ({:.0}%)", 100.0 * p));
+    }
+    s
+}
+
+/// Settings of the live loop.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LiveOptions {
+    /// Stop after this much audio (s); `None`: until the source ends.
+    pub seconds: Option<f64>,
+    /// Redraw one belief line in place (`\r`, for a terminal) instead of one line per step.
+    pub redraw: bool,
+}
+
+/// What a live session did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LiveStats {
+    /// Audio fed to the controller (s, at the blob's rate).
+    pub seconds: f64,
+    /// Steps (syllables and pauses).
+    pub steps: usize,
+    /// Syllables.
+    pub syllables: usize,
+    /// Decisions.
+    pub decisions: usize,
+    /// Animation ticks.
+    pub ticks: u64,
+}
+
+/// Runs `source` through the controller of `blob`, printing decisions and the belief to `out`.
+pub fn live_loop(
+    blob: &Blob<'_>,
+    source: &mut dyn AudioSource,
+    opts: LiveOptions,
+    out: &mut dyn Write,
+) -> Result<LiveStats, LiveError> {
+    let config = blob.prosody_config();
+    let rate = config.sample_rate_hz;
+    let gmm = blob.gmm();
+    let mut controller = Controller::new(&config, gmm.as_slice(), blob.crf_weights(), blob, blob)
+        .map_err(|e| LiveError::Backend(format!("controller: {e}")))?;
+    let mut resampler = StreamResampler::new(source.rate_hz(), rate)?;
+    let fps = blob.fps() as f64;
+    let limit = opts.seconds.map(|s| (s * rate as f64).round() as u64);
+    let mut stats = LiveStats::default();
+    let mut raw = Vec::new();
+    let mut resampled = Vec::new();
+    let mut pcm: Vec<i16> = Vec::new();
+    let mut fed = 0u64;
+    let mut io_err: Option<std::io::Error> = None;
+    writeln!(
+        out,
+        "listening at {} Hz (blob rate {} Hz, {} states, {} segments); Ctrl-C stops",
+        source.rate_hz(),
+        rate,
+        blob.states(),
+        blob.segments()
+    )?;
+    loop {
+        raw.clear();
+        let more = source.read(&mut raw, Duration::from_millis(200))?;
+        resampled.clear();
+        resampler.push(&raw, &mut resampled)?;
+        pcm.clear();
+        pcm.extend(resampled.iter().map(|&x| to_i16(x)));
+        if let Some(l) = limit {
+            let room = l.saturating_sub(fed) as usize;
+            pcm.truncate(room);
+        }
+        fed += pcm.len() as u64;
+        let now = fed as f64 / rate as f64;
+        controller.push(&pcm, &mut |e| {
+            let r = match e {
+                ControllerEvent::Step { step, belief } => {
+                    stats.steps += 1;
+                    if step.kind == StepKind::Syllable {
+                        stats.syllables += 1;
+                    }
+                    let kind = match step.kind {
+                        StepKind::Syllable => "syllable",
+                        StepKind::Pause => "pause   ",
+                    };
+                    let line = format!(
+                        "{now:8.2} s  {kind} {:6.2}-{:6.2} s  {}",
+                        step.start_s(),
+                        step.end_s(),
+                        belief_bar(belief)
+                    );
+                    if opts.redraw {
+                        write!(out, "\r\x1b[K{line}").and_then(|()| out.flush())
+                    } else {
+                        writeln!(out, "{line}")
+                    }
+                }
+                ControllerEvent::Decision { tick, decision } => {
+                    stats.decisions += 1;
+                    let what = match decision.choice {
+                        Choice::Continue => "continue".to_string(),
+                        Choice::Enter(c) => format!("enter segment {c}"),
+                    };
+                    let line = format!(
+                        "{:8.2} s  decision at exit {}: {what} (cost {:.3}, {} candidates)",
+                        tick as f64 / fps,
+                        decision.exit,
+                        decision.cost,
+                        decision.candidates
+                    );
+                    if opts.redraw {
+                        writeln!(out, "\r\x1b[K{line}")
+                    } else {
+                        writeln!(out, "{line}")
+                    }
+                }
+                ControllerEvent::Pose { tick, .. } => {
+                    stats.ticks = tick + 1;
+                    Ok(())
+                }
+                ControllerEvent::Frame(_) => Ok(()),
+            };
+            if let (Err(e), None) = (r, &io_err) {
+                io_err = Some(e);
+            }
+        });
+        if let Some(e) = io_err.take() {
+            return Err(e.into());
+        }
+        stats.seconds = now;
+        if !more || limit.is_some_and(|l| fed >= l) {
+            break;
+        }
+    }
+    controller.finish(&mut |_| {});
+    if opts.redraw {
+        writeln!(out)?;
+    }
+    writeln!(
+        out,
+        "stopped after {:.2} s: {} syllables, {} steps, {} decisions, {} ticks",
+        stats.seconds, stats.syllables, stats.steps, stats.decisions, stats.ticks
+    )?;
+    Ok(stats)
+}
+
+// ----- cpal ------------------------------------------------------------------------------------
+
+/// Runs `f` with ALSA's stderr diagnostics captured (Linux), so a failure is our one line.
+fn quiet_alsa<T>(f: impl FnOnce() -> T) -> T {
+    #[cfg(target_os = "linux")]
+    let _guard = alsa::Output::local_error_handler().ok();
+    f()
+}
+
+/// A device's identifier (ALSA: the PCM name, e.g. `hw:CARD=USB,DEV=0`) and description.
+fn device_id(d: &cpal::Device) -> (String, String) {
+    use cpal::traits::DeviceTrait;
+    match d.description() {
+        Ok(desc) => (
+            desc.driver().unwrap_or(desc.name()).to_string(),
+            desc.name().to_string(),
+        ),
+        Err(_) => (String::new(), String::new()),
+    }
+}
+
+/// ALSA's `null` PCM "captures" endless zeros: it is there on machines without any sound card
+/// and is no microphone, so it is never listed or opened.
+fn is_dummy(d: &cpal::Device) -> bool {
+    device_id(d).0 == "null"
+}
+
+/// The usable input devices: (identifier, description, is the default).
+pub fn input_devices() -> Result<Vec<(String, String, bool)>, LiveError> {
+    use cpal::traits::{DeviceTrait, HostTrait};
+    quiet_alsa(|| {
+        let host = cpal::default_host();
+        let default = host.default_input_device().map(|d| device_id(&d).0);
+        let devices = host
+            .input_devices()
+            .map_err(|e| LiveError::Backend(e.to_string()))?;
+        Ok(devices
+            .filter(|d| !is_dummy(d) && d.supports_input())
+            .map(|d| {
+                let (id, name) = device_id(&d);
+                let is_default = default.as_deref() == Some(id.as_str());
+                (id, name, is_default)
+            })
+            .collect())
+    })
+}
+
+/// `gesture-sim devices`: prints the input devices (`*` marks the default), or fails with
+/// [`LiveError::NoDevice`] when there is none.
+pub fn devices(out: &mut dyn Write) -> Result<(), LiveError> {
+    let list = input_devices()?;
+    if list.is_empty() {
+        return Err(LiveError::NoDevice);
+    }
+    for (id, name, d) in list {
+        writeln!(out, "{}{id}  ({name})", if d { "* " } else { "  " })?;
+    }
+    Ok(())
+}
+
+/// A cpal input stream as an [`AudioSource`]. Keep it on the thread that opened it.
+pub struct CpalSource {
+    _stream: cpal::Stream,
+    rx: Receiver<Vec<f32>>,
+    rate_hz: u32,
+    errors: Arc<Mutex<Option<String>>>,
+    dropped: Arc<Mutex<u64>>,
+}
+
+impl CpalSource {
+    /// Opens the device named `name` (or the default input device) at its default config.
+    pub fn open(name: Option<&str>) -> Result<Self, LiveError> {
+        use cpal::traits::{DeviceTrait, HostTrait, StreamTrait};
+        use cpal::SampleFormat;
+        quiet_alsa(|| {
+            let host = cpal::default_host();
+            let device = match name {
+                None => host
+                    .default_input_device()
+                    .filter(|d| !is_dummy(d))
+                    .ok_or(LiveError::NoDevice)?,
+                Some(n) => {
+                    let all: Vec<cpal::Device> = host
+                        .input_devices()
+                        .map_err(|e| LiveError::Backend(e.to_string()))?
+                        .filter(|d| !is_dummy(d))
+                        .collect();
+                    let names: Vec<String> = all.iter().map(|d| device_id(d).0).collect();
+                    let found = all.into_iter().find(|d| {
+                        let (id, desc) = device_id(d);
+                        id == n || desc == n
+                    });
+                    match found {
+                        Some(d) => d,
+                        None if names.is_empty() => return Err(LiveError::NoDevice),
+                        None => {
+                            return Err(LiveError::DeviceNotFound {
+                                name: n.to_string(),
+                                available: names.join(", "),
+                            })
+                        }
+                    }
+                }
+            };
+            let supported = device.default_input_config().map_err(|e| match name {
+                None => LiveError::NoDevice,
+                Some(_) => LiveError::Backend(e.to_string()),
+            })?;
+            let config = supported.config();
+            let channels = config.channels.max(1) as usize;
+            let rate_hz = config.sample_rate;
+            let (tx, rx) = sync_channel::<Vec<f32>>(256);
+            let errors = Arc::new(Mutex::new(None));
+            let dropped = Arc::new(Mutex::new(0u64));
+            let (e2, d2) = (errors.clone(), dropped.clone());
+            let on_error = move |e: cpal::Error| {
+                if let Ok(mut g) = e2.lock() {
+                    g.get_or_insert(e.to_string());
+                }
+            };
+            // Mixes a block to mono and hands it over without blocking the audio thread.
+            fn sender<T: Copy + Send + 'static>(
+                tx: std::sync::mpsc::SyncSender<Vec<f32>>,
+                dropped: Arc<Mutex<u64>>,
+                channels: usize,
+                conv: fn(T) -> f32,
+            ) -> impl FnMut(&[T], &cpal::InputCallbackInfo) + Send + 'static {
+                move |data: &[T], _| {
+                    let inv = 1.0 / channels as f32;
+                    let mono: Vec<f32> = data
+                        .chunks(channels)
+                        .map(|f| f.iter().map(|&x| conv(x)).sum::<f32>() * inv)
+                        .collect();
+                    if let Err(TrySendError::Full(_)) = tx.try_send(mono) {
+                        if let Ok(mut g) = dropped.lock() {
+                            *g += 1;
+                        }
+                    }
+                }
+            }
+            let backend = |e: cpal::Error| LiveError::Backend(e.to_string());
+            let stream = match supported.sample_format() {
+                SampleFormat::F32 => device.build_input_stream(
+                    config,
+                    sender::<f32>(tx, d2, channels, |x| x),
+                    on_error,
+                    None,
+                ),
+                SampleFormat::I16 => device.build_input_stream(
+                    config,
+                    sender::<i16>(tx, d2, channels, |x| x as f32 / 32768.0),
+                    on_error,
+                    None,
+                ),
+                SampleFormat::I32 => device.build_input_stream(
+                    config,
+                    sender::<i32>(tx, d2, channels, |x| x as f32 / 2_147_483_648.0),
+                    on_error,
+                    None,
+                ),
+                SampleFormat::U16 => device.build_input_stream(
+                    config,
+                    sender::<u16>(tx, d2, channels, |x| (x as f32 - 32768.0) / 32768.0),
+                    on_error,
+                    None,
+                ),
+                other => {
+                    return Err(LiveError::Backend(format!(
+                        "unsupported sample format {other}"
+                    )))
+                }
+            }
+            .map_err(backend)?;
+            stream.play().map_err(backend)?;
+            Ok(Self {
+                _stream: stream,
+                rx,
+                rate_hz,
+                errors,
+                dropped,
+            })
+        })
+    }
+
+    /// Blocks dropped because the controller fell behind.
+    pub fn dropped_blocks(&self) -> u64 {
+        self.dropped.lock().map_or(0, |g| *g)
+    }
+}
+
+impl AudioSource for CpalSource {
+    fn rate_hz(&self) -> u32 {
+        self.rate_hz
+    }
+
+    fn read(&mut self, out: &mut Vec<f32>, timeout: Duration) -> Result<bool, LiveError> {
+        if let Some(e) = self.errors.lock().ok().and_then(|mut g| g.take()) {
+            return Err(LiveError::Backend(e));
+        }
+        match self.rx.recv_timeout(timeout) {
+            Ok(block) => {
+                out.extend(block);
+                while let Ok(b) = self.rx.try_recv() {
+                    out.extend(b);
+                }
+                Ok(true)
+            }
+            Err(RecvTimeoutError::Timeout) => Ok(true),
+            Err(RecvTimeoutError::Disconnected) => Ok(false),
+        }
+    }
+}

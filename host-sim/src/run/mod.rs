@@ -1,0 +1,449 @@
+//! `gesture-sim run`: a WAV file through the runtime's `Controller`, exactly as the board would
+//! run it, and everything it did written to a folder.
+//!
+//! **Inputs, checked before anything is written.** The blob (read and validated by the
+//! runtime's own loader: a refused blob is one line naming the file and the typed error); the
+//! optional rig file (`--rig`), whose calibrations and PWM period replace the blob's for the
+//! virtual servos: it must have exactly the blob's channel names, and it is bound to the blob's
+//! skeleton so a channel naming a missing joint is refused as `pack` would refuse it; the WAV
+//! file (any rate and format `gesture_trainer::audio` reads), resampled to the blob's front-end
+//! rate. Any of these failing is one line on stderr and exit status 2, with `DIR` untouched.
+//!
+//! **Outputs** (in `DIR`, created if needed; all rendered in memory first, then each written
+//! to a temporary file and renamed, so a file is either complete or absent, and on a write
+//! failure no output file is left):
+//!
+//! - `motion.bvh`: the played poses on the library's skeleton ([`crate::skeleton`]), one frame
+//!   per animation tick at the library's frame rate (needs the blob's skeleton section);
+//! - `timeline.json`: steps, beliefs, decisions and detection latencies ([`timeline`]);
+//! - `servo.csv`: `tick,time_s,<channel>...`, the duty cycle of every channel at every tick,
+//!   as written by the runtime's `ServoRig` to virtual 16-bit PWM pins ([`crate::servo`]);
+//! - `preview.png` and `preview.gif` ([`preview`]).
+//!
+//! The summary on stdout gives the files, the audio duration, the decisions, the median and
+//! maximum syllable detection latency and the simulation speed as a multiple of real time
+//! (simulation only, without rendering and writing).
+
+pub mod preview;
+pub mod sim;
+pub mod timeline;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use gesture_runtime::blob::{Blob, BlobError};
+use gesture_runtime::prosody::StepKind;
+use gesture_runtime::rig::ChannelCal;
+use gesture_trainer::audio::{load_wav_at, AudioError};
+use gesture_trainer::motion::write_bvh;
+use gesture_trainer::rig::{Rig, RigError};
+
+use crate::skeleton::PoseSkeleton;
+use sim::{median_max, simulate, SimOptions, Simulation};
+
+/// What `run` was asked to do.
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    /// Policy blob.
+    pub blob: PathBuf,
+    /// Audio file.
+    pub audio: PathBuf,
+    /// Output folder.
+    pub out: PathBuf,
+    /// Rig file overriding the blob's calibration.
+    pub rig: Option<PathBuf>,
+    /// Pace the simulation on the wall clock.
+    pub realtime: bool,
+    /// Audio chunk length (ms).
+    pub chunk_ms: f64,
+}
+
+/// Why `run` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The blob file could not be read.
+    #[error("{}: cannot read the blob: {source}", path.display())]
+    ReadBlob {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The runtime refused the blob.
+    #[error("{}: {source}", path.display())]
+    Blob {
+        /// The file.
+        path: PathBuf,
+        /// The runtime's reason.
+        source: BlobError,
+    },
+    /// The rig file is unusable or does not fit the blob's skeleton (boxed: it is large).
+    #[error(transparent)]
+    Rig(Box<RigError>),
+    /// The rig file's channels are not the blob's.
+    #[error("{}: {reason}", path.display())]
+    RigMismatch {
+        /// The rig file.
+        path: PathBuf,
+        /// What differs.
+        reason: String,
+    },
+    /// The audio file could not be loaded.
+    #[error(transparent)]
+    Audio(#[from] AudioError),
+    /// The output path exists and is not a folder.
+    #[error("{}: exists and is not a folder (give a folder for the outputs)", path.display())]
+    OutNotDir {
+        /// The path.
+        path: PathBuf,
+    },
+    /// The simulation could not be set up (a bug: the blob was validated).
+    #[error("simulation: {0}")]
+    Sim(String),
+    /// An output could not be rendered.
+    #[error("rendering {what}: {reason}")]
+    Render {
+        /// The file.
+        what: &'static str,
+        /// Why.
+        reason: String,
+    },
+    /// An output could not be written.
+    #[error("{}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+impl From<RigError> for RunError {
+    fn from(e: RigError) -> Self {
+        Self::Rig(Box::new(e))
+    }
+}
+
+impl RunError {
+    /// Exit status: 2 for bad input, 1 for failures of our own or of the file system.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::ReadBlob { .. }
+            | Self::Blob { .. }
+            | Self::Rig(_)
+            | Self::RigMismatch { .. }
+            | Self::Audio(_)
+            | Self::OutNotDir { .. } => 2,
+            Self::Sim(_) | Self::Render { .. } | Self::Write { .. } => 1,
+        }
+    }
+}
+
+/// Reads and validates a blob file (the bytes; parse them with [`Blob::parse`]).
+pub fn read_blob(path: &Path) -> Result<Vec<u8>, RunError> {
+    let bytes = std::fs::read(path).map_err(|source| RunError::ReadBlob {
+        path: path.to_owned(),
+        source,
+    })?;
+    Blob::parse(&bytes).map_err(|source| RunError::Blob {
+        path: path.to_owned(),
+        source,
+    })?;
+    Ok(bytes)
+}
+
+/// The servo calibrations and PWM period for the virtual rig: the blob's, or those of the rig
+/// file at `rig` (same channel names; bound to the blob's skeleton when it has one).
+pub fn calibrations(
+    blob: &Blob<'_>,
+    blob_path: &Path,
+    rig: Option<&Path>,
+) -> Result<(Vec<ChannelCal>, f32), RunError> {
+    let Some(path) = rig else {
+        let cals = (0..blob.channels())
+            .map(|c| blob.calibration(c).unwrap_or(ChannelCal::HOBBY))
+            .collect();
+        return Ok((cals, blob.period_us()));
+    };
+    let r = Rig::load(path)?;
+    if let Some(sk) = blob.skeleton() {
+        let pose = PoseSkeleton::from_blob(&sk).map_err(|e| RunError::Sim(e.to_string()))?;
+        r.bind(
+            pose.skeleton(),
+            &format!("{} (the blob's skeleton)", blob_path.display()),
+        )?;
+    }
+    let names: Vec<&str> = blob.channel_names().collect();
+    let mismatch = |reason: String| RunError::RigMismatch {
+        path: path.to_owned(),
+        reason,
+    };
+    let mut cals = Vec::with_capacity(names.len());
+    for n in &names {
+        match r.channels.iter().find(|c| c.name == *n) {
+            Some(c) => cals.push(c.cal),
+            None => {
+                return Err(mismatch(format!(
+                    "rig `{}` has no channel `{n}`, which the blob drives (the blob's channels: \
+                     {}); use a rig file with the blob's channel names",
+                    r.name,
+                    names.join(", ")
+                )))
+            }
+        }
+    }
+    if let Some(extra) = r
+        .channels
+        .iter()
+        .find(|c| !names.contains(&c.name.as_str()))
+    {
+        return Err(mismatch(format!(
+            "rig channel `{}` is not in the blob (the blob's channels: {}); use a rig file \
+             with the blob's channel names",
+            extra.name,
+            names.join(", ")
+        )));
+    }
+    Ok((cals, r.period_us))
+}
+
+/// The rendered output files, in memory.
+pub struct Outputs {
+    /// `(file name, bytes)`.
+    pub files: Vec<(&'static str, Vec<u8>)>,
+    /// Frames in `motion.bvh` (0 if not written).
+    pub bvh_frames: usize,
+}
+
+/// `servo.csv` of a run.
+pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
+    let mut s = String::from("tick,time_s");
+    for n in names {
+        s.push(',');
+        s.push_str(n);
+    }
+    s.push('\n');
+    for (tick, row) in sim.duties.iter().enumerate() {
+        s.push_str(&format!("{tick},{:.4}", tick as f64 / sim.fps));
+        for d in row {
+            s.push_str(&format!(",{d}"));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Renders every output of a run.
+pub fn render(
+    sim: &Simulation,
+    blob: &Blob<'_>,
+    cx: timeline::Context<'_>,
+) -> Result<Outputs, RunError> {
+    let render_err = |what| move |reason: String| RunError::Render { what, reason };
+    let skeleton = match blob.skeleton() {
+        Some(v) => {
+            Some(PoseSkeleton::from_blob(&v).map_err(|e| render_err("motion.bvh")(e.to_string()))?)
+        }
+        None => None,
+    };
+    let mut files = Vec::new();
+    let mut bvh_frames = 0;
+    if let Some(sk) = &skeleton {
+        let motion = sk
+            .motion(&sim.poses, sim.fps)
+            .map_err(|e| render_err("motion.bvh")(e.to_string()))?;
+        let mut bytes = Vec::new();
+        write_bvh(&motion, &mut bytes).map_err(|e| render_err("motion.bvh")(e.to_string()))?;
+        bvh_frames = motion.frames();
+        files.push(("motion.bvh", bytes));
+    }
+    files.push((
+        "timeline.json",
+        timeline::Timeline::new(sim, cx).to_json().into_bytes(),
+    ));
+    let names: Vec<&str> = blob.channel_names().collect();
+    files.push(("servo.csv", servo_csv(sim, &names).into_bytes()));
+    files.push((
+        "preview.png",
+        preview::contact_sheet(sim, skeleton.as_ref()).map_err(render_err("preview.png"))?,
+    ));
+    files.push((
+        "preview.gif",
+        preview::animation(sim, skeleton.as_ref()).map_err(render_err("preview.gif"))?,
+    ));
+    Ok(Outputs { files, bvh_frames })
+}
+
+/// Writes `files` into `dir` (created if needed): every file first to a temporary sibling,
+/// then all renamed. On failure the temporaries are removed and no output file is left.
+pub fn write_all(dir: &Path, files: &[(&'static str, Vec<u8>)]) -> Result<Vec<PathBuf>, RunError> {
+    let werr = |path: &Path| {
+        let path = path.to_owned();
+        move |source| RunError::Write { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(werr(dir))?;
+    let pid = std::process::id();
+    let mut temps: Vec<(PathBuf, PathBuf)> = Vec::new();
+    let cleanup = |temps: &[(PathBuf, PathBuf)]| {
+        for (t, _) in temps {
+            let _ = std::fs::remove_file(t);
+        }
+    };
+    for (name, bytes) in files {
+        let target = dir.join(name);
+        let tmp = dir.join(format!(".{name}.tmp{pid}"));
+        let res = (|| {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        temps.push((tmp.clone(), target));
+        if let Err(e) = res {
+            cleanup(&temps);
+            return Err(werr(&tmp)(e));
+        }
+    }
+    let mut done = Vec::new();
+    for (i, (tmp, target)) in temps.iter().enumerate() {
+        if let Err(e) = std::fs::rename(tmp, target) {
+            cleanup(&temps[i..]);
+            for d in &done {
+                let _ = std::fs::remove_file(d);
+            }
+            return Err(werr(target)(e));
+        }
+        done.push(target.clone());
+    }
+    Ok(done)
+}
+
+/// Runs the command; the summary goes to `out`.
+pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::cli::CliError> {
+    let total = Instant::now();
+    // Inputs first: nothing is written unless all of them are usable.
+    if cfg.out.exists() && !cfg.out.is_dir() {
+        return Err(RunError::OutNotDir {
+            path: cfg.out.clone(),
+        }
+        .into());
+    }
+    let bytes = read_blob(&cfg.blob)?;
+    let blob = Blob::parse(&bytes).map_err(|source| RunError::Blob {
+        path: cfg.blob.clone(),
+        source,
+    })?;
+    let (cals, period_us) = calibrations(&blob, &cfg.blob, cfg.rig.as_deref())?;
+    let rate = blob.prosody_config().sample_rate_hz;
+    let pcm = load_wav_at(&cfg.audio, rate).map_err(RunError::from)?;
+    let chunk = ((cfg.chunk_ms / 1000.0 * rate as f64).round() as usize).max(1);
+    let sim = simulate(
+        &blob,
+        &pcm.samples,
+        &cals,
+        period_us,
+        SimOptions {
+            chunk,
+            realtime: cfg.realtime,
+        },
+    )
+    .map_err(RunError::Sim)?;
+    let audio_name = cfg.audio.display().to_string();
+    let blob_name = cfg.blob.display().to_string();
+    let outputs = render(
+        &sim,
+        &blob,
+        timeline::Context {
+            audio: &audio_name,
+            blob: &blob_name,
+            states: blob.states(),
+            segments: blob.segments(),
+            exit_points: blob.exit_points(),
+            chunk_s: chunk as f64 / rate as f64,
+        },
+    )?;
+    let written = write_all(&cfg.out, &outputs.files)?;
+    summary(
+        out,
+        cfg,
+        &blob,
+        &sim,
+        &outputs,
+        &written,
+        total.elapsed().as_secs_f64(),
+    )?;
+    Ok(())
+}
+
+fn summary(
+    out: &mut impl Write,
+    cfg: &RunConfig,
+    blob: &Blob<'_>,
+    sim: &Simulation,
+    outputs: &Outputs,
+    written: &[PathBuf],
+    total_s: f64,
+) -> std::io::Result<()> {
+    let syllables = sim
+        .steps
+        .iter()
+        .filter(|s| s.kind == StepKind::Syllable)
+        .count();
+    let entered = sim.decisions.iter().filter(|d| d.entered.is_some()).count();
+    writeln!(
+        out,
+        "ran {} ({:.2} s) through {} (rig {:?}, {} channels, {} states, {} segments){}",
+        cfg.audio.display(),
+        sim.duration_s,
+        cfg.blob.display(),
+        blob.rig_name(),
+        blob.channels(),
+        blob.states(),
+        blob.segments(),
+        if cfg.realtime {
+            ", paced in real time"
+        } else {
+            ""
+        }
+    )?;
+    for p in written {
+        let extra = match p.file_name().and_then(|n| n.to_str()) {
+            Some("motion.bvh") => format!(" ({} frames at {} fps)", outputs.bvh_frames, sim.fps),
+            Some("servo.csv") => format!(" ({} ticks)", sim.duties.len()),
+            _ => String::new(),
+        };
+        writeln!(out, "wrote {}{extra}", p.display())?;
+    }
+    if blob.skeleton().is_none() {
+        writeln!(
+            out,
+            "no motion.bvh: the blob has no skeleton section (packed with --no-skeleton)"
+        )?;
+    }
+    writeln!(
+        out,
+        "steps: {} syllables, {} pause steps; decisions: {} ({} entered a segment, {} continued)",
+        syllables,
+        sim.steps.len() - syllables,
+        sim.decisions.len(),
+        entered,
+        sim.decisions.len() - entered
+    )?;
+    match median_max(&sim.syllable_latencies()) {
+        Some((med, max)) => writeln!(
+            out,
+            "detection latency (syllable end -> belief update): median {:.3} s, max {:.3} s",
+            med, max
+        )?,
+        None => writeln!(out, "detection latency: no syllables detected")?,
+    }
+    writeln!(
+        out,
+        "speed: {:.1}x real time ({:.3} s to simulate {:.2} s of audio; {:.2} s in all with \
+         rendering and writing)",
+        sim.speed(),
+        sim.wall_s,
+        sim.duration_s,
+        total_s
+    )
+}

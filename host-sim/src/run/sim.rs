@@ -1,0 +1,246 @@
+//! The simulation itself: PCM at the blob's rate through the runtime's `Controller` in fixed
+//! chunks, every event recorded, every pose sent through the virtual servo rig.
+//!
+//! **Timing.** Samples arrive in chunks of `chunk` samples (10 ms by default), as a board's
+//! audio DMA would deliver them. A chunk is processed when its last sample has arrived, so a
+//! step reported while pushing a chunk is *detected* at that chunk's end time: the detection
+//! latency of a syllable is that time minus the syllable's end (the front-end's analysis
+//! windows and its 50 ms path-finder lag, plus up to one chunk). At the end of the audio the
+//! controller is finished (`Controller::finish`), so the last syllable is reported at the end
+//! time; such steps are marked `flushed` and left out of the latency figures (they were closed
+//! by the end of the input, not detected). With `realtime`, each chunk waits until its end time
+//! on the wall clock.
+
+use std::time::{Duration, Instant};
+
+use gesture_runtime::blob::Blob;
+use gesture_runtime::controller::{Controller, ControllerError, ControllerEvent};
+use gesture_runtime::policy::Choice;
+use gesture_runtime::prosody::StepKind;
+use gesture_runtime::rig::ChannelCal;
+
+use crate::servo::VirtualRig;
+
+/// One prosody frame (10 ms).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameRecord {
+    /// Centre time (s).
+    pub time_s: f64,
+    /// Intensity (dB).
+    pub intensity_db: f32,
+    /// F0 (Hz) when voiced.
+    pub f0_hz: Option<f32>,
+}
+
+/// One step (syllable or pause) and the belief after it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepRecord {
+    /// Syllable or pause.
+    pub kind: StepKind,
+    /// Start (s).
+    pub start_s: f64,
+    /// End (s).
+    pub end_s: f64,
+    /// Mean F0 over voiced frames (Hz).
+    pub f0_hz: Option<f32>,
+    /// Mean intensity (dB).
+    pub intensity_db: f32,
+    /// Length (s).
+    pub length_s: f32,
+    /// When the belief update happened on the sample clock (s): the end of the chunk whose
+    /// processing reported the step.
+    pub detected_s: f64,
+    /// Belief over states after the step.
+    pub belief: Vec<f32>,
+    /// Reported only because the audio ended (`Controller::finish` closed it): no detection
+    /// latency is measured for it.
+    pub flushed: bool,
+}
+
+impl StepRecord {
+    /// Detection latency (s): `detected_s - end_s`.
+    pub fn latency_s(&self) -> f64 {
+        self.detected_s - self.end_s
+    }
+}
+
+/// One decision at an exit point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DecisionRecord {
+    /// Animation tick.
+    pub tick: u64,
+    /// Tick time (s).
+    pub time_s: f64,
+    /// Exit point index.
+    pub exit: usize,
+    /// The exit point's segment.
+    pub exit_segment: usize,
+    /// The exit point's frame within its segment.
+    pub exit_frame: usize,
+    /// Segment entered, `None` for "continue".
+    pub entered: Option<usize>,
+    /// Candidates weighed.
+    pub candidates: usize,
+    /// Expected cost of the choice.
+    pub cost: f32,
+}
+
+/// Everything a run produced.
+#[derive(Clone, Debug, Default)]
+pub struct Simulation {
+    /// Front-end rate (Hz).
+    pub sample_rate_hz: u32,
+    /// Animation ticks per second (the library's fps).
+    pub fps: f64,
+    /// Audio duration (s).
+    pub duration_s: f64,
+    /// Prosody frames.
+    pub frames: Vec<FrameRecord>,
+    /// Steps with beliefs.
+    pub steps: Vec<StepRecord>,
+    /// Decisions.
+    pub decisions: Vec<DecisionRecord>,
+    /// One pose per tick (rig channel values, degrees).
+    pub poses: Vec<Vec<f32>>,
+    /// One row of duty cycles per tick, from the virtual servo rig.
+    pub duties: Vec<Vec<u16>>,
+    /// Wall-clock time of the simulation (s).
+    pub wall_s: f64,
+}
+
+impl Simulation {
+    /// Detection latencies of the syllables (not pause steps, not those closed by the end of
+    /// the audio), in order (s).
+    pub fn syllable_latencies(&self) -> Vec<f64> {
+        self.steps
+            .iter()
+            .filter(|s| s.kind == StepKind::Syllable && !s.flushed)
+            .map(StepRecord::latency_s)
+            .collect()
+    }
+
+    /// Audio seconds per wall-clock second.
+    pub fn speed(&self) -> f64 {
+        self.duration_s / self.wall_s.max(1e-9)
+    }
+}
+
+/// Median and maximum of `v` (`None` if empty).
+pub fn median_max(v: &[f64]) -> Option<(f64, f64)> {
+    if v.is_empty() {
+        return None;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    let median = if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    };
+    Some((median, s[n - 1]))
+}
+
+/// How to run.
+#[derive(Clone, Copy, Debug)]
+pub struct SimOptions {
+    /// Samples per chunk (>= 1).
+    pub chunk: usize,
+    /// Pace the chunks on the wall clock.
+    pub realtime: bool,
+}
+
+/// Runs `samples` (at the blob's rate) through the controller of `blob`, with servo
+/// calibrations `cals` and PWM period `period_us` for the virtual rig.
+pub fn simulate(
+    blob: &Blob<'_>,
+    samples: &[i16],
+    cals: &[ChannelCal],
+    period_us: f32,
+    opts: SimOptions,
+) -> Result<Simulation, String> {
+    let config = blob.prosody_config();
+    let gmm = blob.gmm();
+    let mut controller = Controller::new(&config, gmm.as_slice(), blob.crf_weights(), blob, blob)
+        .map_err(|e: ControllerError| e.to_string())?;
+    let fps = blob.fps() as f64;
+    let mut rig =
+        VirtualRig::new(cals, period_us, (1.0 / fps) as f32).map_err(|e| e.to_string())?;
+    let rate = config.sample_rate_hz;
+    let mut sim = Simulation {
+        sample_rate_hz: rate,
+        fps,
+        duration_s: samples.len() as f64 / rate as f64,
+        ..Simulation::default()
+    };
+    let start = Instant::now();
+    let mut pushed = 0usize;
+    for chunk in samples.chunks(opts.chunk.max(1)) {
+        pushed += chunk.len();
+        let now_s = pushed as f64 / rate as f64;
+        if opts.realtime {
+            let due = Duration::from_secs_f64(now_s);
+            if let Some(wait) = due.checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+        }
+        controller.push(chunk, &mut |e| {
+            record(&mut sim, &mut rig, blob, now_s, false, e)
+        });
+    }
+    let now_s = pushed as f64 / rate as f64;
+    controller.finish(&mut |e| record(&mut sim, &mut rig, blob, now_s, true, e));
+    sim.wall_s = start.elapsed().as_secs_f64();
+    Ok(sim)
+}
+
+/// Records one controller event (`now_s`: the sample clock at the end of the current chunk;
+/// `flushed`: reported by the end of the stream).
+fn record(
+    sim: &mut Simulation,
+    rig: &mut VirtualRig,
+    blob: &Blob<'_>,
+    now_s: f64,
+    flushed: bool,
+    e: ControllerEvent<'_>,
+) {
+    let fps = sim.fps;
+    match e {
+        ControllerEvent::Frame(f) => sim.frames.push(FrameRecord {
+            time_s: f.time_s(),
+            intensity_db: f.intensity_db,
+            f0_hz: f.f0_hz,
+        }),
+        ControllerEvent::Step { step, belief } => sim.steps.push(StepRecord {
+            kind: step.kind,
+            start_s: step.start_s(),
+            end_s: step.end_s(),
+            f0_hz: step.f0_hz,
+            intensity_db: step.intensity_db,
+            length_s: step.length_s(),
+            detected_s: now_s,
+            belief: belief.to_vec(),
+            flushed,
+        }),
+        ControllerEvent::Decision { tick, decision } => {
+            let x = blob.exit(decision.exit);
+            sim.decisions.push(DecisionRecord {
+                tick,
+                time_s: tick as f64 / fps,
+                exit: decision.exit,
+                exit_segment: x.map_or(0, |x| x.segment as usize),
+                exit_frame: x.map_or(0, |x| x.frame as usize),
+                entered: match decision.choice {
+                    Choice::Continue => None,
+                    Choice::Enter(c) => Some(c),
+                },
+                candidates: decision.candidates,
+                cost: decision.cost,
+            })
+        }
+        ControllerEvent::Pose { pose, .. } => {
+            sim.poses.push(pose.to_vec());
+            sim.duties.push(rig.apply(pose));
+        }
+    }
+}

@@ -1,0 +1,172 @@
+//! `timeline.json`: what the controller heard, believed and chose, in time order.
+//!
+//! ```text
+//! { "format": "gesture-sim-timeline", "version": 1,
+//!   "audio": PATH, "blob": PATH, "sample_rate_hz", "fps", "duration_s", "ticks",
+//!   "states", "segments", "exit_points", "chunk_s",
+//!   "steps": [ { "kind": "syllable" | "pause", "start_s", "end_s", "f0_hz" (null when
+//!                unvoiced), "intensity_db", "length_s", "detected_s", "latency_s" (null
+//!                when "flushed"), "flushed", "belief": [S numbers] } ],
+//!   "decisions": [ { "time_s", "tick", "exit", "exit_segment", "exit_frame",
+//!                    "choice": "continue" | "enter", "segment" (entered, or null),
+//!                    "candidates", "cost" } ],
+//!   "latency": { "syllables", "median_s", "max_s" } }
+//! ```
+//!
+//! Times are seconds on the audio's clock. `detected_s` is when the belief update happened:
+//! the end of the audio chunk whose processing reported the step (see `run::sim`);
+//! `latency_s = detected_s - end_s`; `flushed` steps were closed by the end of the audio and
+//! have no latency. `belief` is the CRF forward belief after the step. The `latency` summary
+//! is over the syllables that are not flushed.
+
+use serde::Serialize;
+
+use super::sim::{median_max, Simulation};
+use gesture_runtime::prosody::StepKind;
+
+/// The whole file.
+#[derive(Debug, Serialize)]
+pub struct Timeline<'a> {
+    format: &'static str,
+    version: u32,
+    audio: &'a str,
+    blob: &'a str,
+    sample_rate_hz: u32,
+    fps: f64,
+    duration_s: f64,
+    ticks: usize,
+    states: usize,
+    segments: usize,
+    exit_points: usize,
+    chunk_s: f64,
+    steps: Vec<Step>,
+    decisions: Vec<Decision>,
+    latency: Latency,
+}
+
+#[derive(Debug, Serialize)]
+struct Step {
+    kind: &'static str,
+    start_s: f64,
+    end_s: f64,
+    f0_hz: Option<f32>,
+    intensity_db: f32,
+    length_s: f32,
+    detected_s: f64,
+    latency_s: Option<f64>,
+    flushed: bool,
+    belief: Vec<f32>,
+}
+
+#[derive(Debug, Serialize)]
+struct Decision {
+    time_s: f64,
+    tick: u64,
+    exit: usize,
+    exit_segment: usize,
+    exit_frame: usize,
+    choice: &'static str,
+    segment: Option<usize>,
+    candidates: usize,
+    cost: f32,
+}
+
+#[derive(Debug, Serialize)]
+struct Latency {
+    syllables: usize,
+    median_s: Option<f64>,
+    max_s: Option<f64>,
+}
+
+/// What the timeline says about the run besides the simulation.
+#[derive(Clone, Copy, Debug)]
+pub struct Context<'a> {
+    /// Audio file as given.
+    pub audio: &'a str,
+    /// Blob file as given.
+    pub blob: &'a str,
+    /// Hidden states.
+    pub states: usize,
+    /// Library segments.
+    pub segments: usize,
+    /// Exit points.
+    pub exit_points: usize,
+    /// Chunk length (s).
+    pub chunk_s: f64,
+}
+
+/// Rounds to 6 decimals so the file stays readable (microsecond times).
+fn r6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+impl<'a> Timeline<'a> {
+    /// The timeline of `sim`.
+    pub fn new(sim: &Simulation, cx: Context<'a>) -> Self {
+        let lat = sim.syllable_latencies();
+        let mm = median_max(&lat);
+        Self {
+            format: "gesture-sim-timeline",
+            version: 1,
+            audio: cx.audio,
+            blob: cx.blob,
+            sample_rate_hz: sim.sample_rate_hz,
+            fps: sim.fps,
+            duration_s: r6(sim.duration_s),
+            ticks: sim.poses.len(),
+            states: cx.states,
+            segments: cx.segments,
+            exit_points: cx.exit_points,
+            chunk_s: r6(cx.chunk_s),
+            steps: sim
+                .steps
+                .iter()
+                .map(|s| Step {
+                    kind: match s.kind {
+                        StepKind::Syllable => "syllable",
+                        StepKind::Pause => "pause",
+                    },
+                    start_s: r6(s.start_s),
+                    end_s: r6(s.end_s),
+                    f0_hz: s.f0_hz,
+                    intensity_db: s.intensity_db,
+                    length_s: s.length_s,
+                    detected_s: r6(s.detected_s),
+                    latency_s: (!s.flushed).then(|| r6(s.latency_s())),
+                    flushed: s.flushed,
+                    belief: s.belief.clone(),
+                })
+                .collect(),
+            decisions: sim
+                .decisions
+                .iter()
+                .map(|d| Decision {
+                    time_s: r6(d.time_s),
+                    tick: d.tick,
+                    exit: d.exit,
+                    exit_segment: d.exit_segment,
+                    exit_frame: d.exit_frame,
+                    choice: if d.entered.is_some() {
+                        "enter"
+                    } else {
+                        "continue"
+                    },
+                    segment: d.entered,
+                    candidates: d.candidates,
+                    cost: d.cost,
+                })
+                .collect(),
+            latency: Latency {
+                syllables: lat.len(),
+                median_s: mm.map(|m| r6(m.0)),
+                max_s: mm.map(|m| r6(m.1)),
+            },
+        }
+    }
+
+    /// The JSON text (pretty, one field per line).
+    pub fn to_json(&self) -> String {
+        // Serializing plain structs of numbers and strings cannot fail.
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+}

@@ -1,0 +1,240 @@
+//! Rig poses back on the library's skeleton: the blob's host-side `skeleton` section
+//! (docs/blob-format.md 3.6) as a trainer [`Skeleton`], and each played pose as a BVH frame.
+//!
+//! ## How a pose becomes a frame (the choice, also stated in the format doc)
+//!
+//! Start from the rest frame (the library's first frame). Then, joint by joint in file order
+//! (so a chain's upper joints are final before the joints below them):
+//!
+//! - a channel in **channel** mode (the full-skeleton rig) writes its value into the joint's
+//!   own rotation channel: the library's frames come back exactly, up to the blob's 16-bit
+//!   quantization (at most range / 65534 degrees per channel);
+//! - the other channels of a joint (puppet rigs: twist or Euler angles, maybe over a
+//!   `relative_to` chain) start from the chain's current rotation `R` and replace what they
+//!   control: an Euler channel sets its angle of the decomposition in the rig's order; a twist
+//!   channel sets the twist about its axis and keeps the swing (`R <- R * Rot(axis, new - old)`,
+//!   exact because twists about one axis commute). The joint then gets the local rotation that
+//!   makes its chain equal `R` (joints above it in the chain keep their values), written in its
+//!   own channel order.
+//!
+//! So reading the rig back from the rebuilt frame (the trainer's `BoundRig::channel_values`)
+//! gives the pose again for one channel per joint and for Euler gimbals; two twist channels on
+//! one joint are applied in rig order and the second can disturb the first slightly. Joints no
+//! channel drives, and the root position, keep their rest values: a puppet rig moves only its
+//! joints, the character stays in place.
+//!
+//! Everything here is `f64`; nothing panics on a validated blob (the section's indices were
+//! checked at load).
+
+use gesture_runtime::blob::{DriveMode, SkeletonView};
+use gesture_trainer::motion::fk::{axis_rotation, local_transform, mat_mul, Mat3, IDENTITY};
+use gesture_trainer::motion::{Channel, Joint, Motion, MotionError, Skeleton};
+use gesture_trainer::rig::{euler_angles, twist_deg, Axis};
+
+/// The blob's skeleton, rest frame and rig channel drives, ready to rebuild frames.
+#[derive(Clone, Debug)]
+pub struct PoseSkeleton {
+    skeleton: Skeleton,
+    rest: Vec<f64>,
+    starts: Vec<usize>,
+    /// Per rig channel: (joint, chain top, axis, mode).
+    drives: Vec<(usize, usize, Axis, DriveMode)>,
+}
+
+const CODES: [Channel; 6] = [
+    Channel::Xposition,
+    Channel::Yposition,
+    Channel::Zposition,
+    Channel::Xrotation,
+    Channel::Yrotation,
+    Channel::Zrotation,
+];
+
+fn transpose(m: &Mat3) -> Mat3 {
+    let mut t = [[0.0; 3]; 3];
+    for (r, row) in m.iter().enumerate() {
+        for (c, v) in row.iter().enumerate() {
+            t[c][r] = *v;
+        }
+    }
+    t
+}
+
+impl PoseSkeleton {
+    /// From a validated blob's skeleton section.
+    pub fn from_blob(v: &SkeletonView<'_>) -> Result<Self, MotionError> {
+        let joints: Vec<Joint> = (0..v.joints())
+            .map(|j| Joint {
+                name: v.joint_name(j).unwrap_or("").to_string(),
+                parent: v.parent(j),
+                offset: v.offset(j).map(f64::from),
+                channels: v
+                    .joint_channels(j)
+                    .filter_map(|i| v.channel_code(i))
+                    .map(|c| CODES[(c as usize).min(5)])
+                    .collect(),
+                end_site: v.end_site(j).map(|e| e.map(f64::from)),
+            })
+            .collect();
+        let skeleton = Skeleton { joints };
+        skeleton.validate()?;
+        let rest = (0..v.channel_count()).map(|i| v.rest(i) as f64).collect();
+        let drives = (0..v.drives())
+            .filter_map(|ch| v.drive(ch))
+            .map(|d| {
+                let axis = Axis {
+                    index: d.axis as usize,
+                    negated: d.negated,
+                };
+                (d.joint as usize, d.chain_top as usize, axis, d.mode)
+            })
+            .collect();
+        Ok(Self {
+            starts: skeleton.channel_starts(),
+            skeleton,
+            rest,
+            drives,
+        })
+    }
+
+    /// The skeleton.
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// The rest frame (one value per BVH channel).
+    pub fn rest(&self) -> &[f64] {
+        &self.rest
+    }
+
+    fn local_rotation(&self, frame: &[f64], j: usize) -> Mat3 {
+        let joint = &self.skeleton.joints[j];
+        let s = self.starts[j];
+        local_transform(joint, &frame[s..s + joint.channels.len()]).0
+    }
+
+    /// The chain from `top` down to `joint` (top first); just `joint` if `top` is not above it.
+    fn chain(&self, joint: usize, top: usize) -> Vec<usize> {
+        let mut c = vec![joint];
+        let mut cur = joint;
+        while cur != top {
+            match self.skeleton.joints[cur].parent {
+                Some(p) => {
+                    c.push(p);
+                    cur = p;
+                }
+                None => return vec![joint],
+            }
+        }
+        c.reverse();
+        c
+    }
+
+    /// Writes rotation `m` into joint `j`'s rotation channels (decomposed in their order).
+    fn set_local_rotation(&self, frame: &mut [f64], j: usize, m: &Mat3) {
+        let joint = &self.skeleton.joints[j];
+        let rot: Vec<(usize, usize)> = joint
+            .channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.is_rotation())
+            .map(|(k, c)| (k, c.axis()))
+            .collect();
+        if rot.is_empty() {
+            return;
+        }
+        // The joint's order, completed with the axes it lacks (their angles are dropped).
+        let mut order: Vec<usize> = rot.iter().map(|&(_, a)| a).collect();
+        for a in 0..3 {
+            if !order.contains(&a) {
+                order.push(a);
+            }
+        }
+        let angles = euler_angles(m, [order[0], order[1], order[2]]);
+        for (i, &(k, _)) in rot.iter().enumerate() {
+            frame[self.starts[j] + k] = angles[i];
+        }
+    }
+
+    /// The BVH frame showing `pose` (one value per rig channel, degrees; see the module docs).
+    pub fn frame(&self, pose: &[f32]) -> Vec<f64> {
+        let mut frame = self.rest.clone();
+        // Channel mode: the joint's own channel.
+        for (&(j, _, axis, mode), &v) in self.drives.iter().zip(pose) {
+            if mode != DriveMode::Channel {
+                continue;
+            }
+            let joint = &self.skeleton.joints[j];
+            let want = [Channel::Xrotation, Channel::Yrotation, Channel::Zrotation][axis.index];
+            if let Some(k) = joint.channels.iter().position(|&c| c == want) {
+                let sign = if axis.negated { -1.0 } else { 1.0 };
+                frame[self.starts[j] + k] = sign * v as f64;
+            }
+        }
+        // Angle modes, joint by joint in file order.
+        let mut joints: Vec<usize> = self
+            .drives
+            .iter()
+            .filter(|d| d.3 != DriveMode::Channel)
+            .map(|d| d.0)
+            .collect();
+        joints.sort_unstable();
+        joints.dedup();
+        for j in joints {
+            let mine: Vec<(usize, Axis, DriveMode, f64)> = self
+                .drives
+                .iter()
+                .zip(pose)
+                .filter(|(d, _)| d.0 == j && d.3 != DriveMode::Channel)
+                .map(|(d, &v)| (d.1, d.2, d.3, v as f64))
+                .collect();
+            let top = mine[0].0;
+            let chain = self.chain(j, top);
+            let above = chain[..chain.len() - 1].iter().fold(IDENTITY, |acc, &k| {
+                mat_mul(&acc, &self.local_rotation(&frame, k))
+            });
+            let mut r = mat_mul(&above, &self.local_rotation(&frame, j));
+            for &(_, axis, mode, v) in &mine {
+                let sign = if axis.negated { -1.0 } else { 1.0 };
+                let target = sign * v;
+                match mode {
+                    DriveMode::Twist => {
+                        let plain = Axis {
+                            index: axis.index,
+                            negated: false,
+                        };
+                        let old = twist_deg(&r, plain);
+                        r = mat_mul(&r, &axis_rotation(axis.index, target - old));
+                    }
+                    DriveMode::Euler(o) => {
+                        let order = [o[0] as usize, o[1] as usize, o[2] as usize];
+                        let mut a = euler_angles(&r, order);
+                        if let Some(k) = order.iter().position(|&x| x == axis.index) {
+                            a[k] = target;
+                        }
+                        r = mat_mul(
+                            &mat_mul(
+                                &axis_rotation(order[0], a[0]),
+                                &axis_rotation(order[1], a[1]),
+                            ),
+                            &axis_rotation(order[2], a[2]),
+                        );
+                    }
+                    DriveMode::Channel => {}
+                }
+            }
+            let local = mat_mul(&transpose(&above), &r);
+            self.set_local_rotation(&mut frame, j, &local);
+        }
+        frame
+    }
+
+    /// A motion of `poses` at `fps` frames per second.
+    pub fn motion(&self, poses: &[Vec<f32>], fps: f64) -> Result<Motion, MotionError> {
+        let mut data = Vec::with_capacity(poses.len() * self.rest.len());
+        for p in poses {
+            data.extend(self.frame(p));
+        }
+        Motion::new(self.skeleton.clone(), 1.0 / fps, poses.len(), data)
+    }
+}
