@@ -104,6 +104,8 @@ impl fmt::Display for RunError {
 /// Measurement hooks (the firmware's `measure` build times the controller with them).
 /// Every method defaults to nothing.
 pub trait Probe {
+    /// The controller is built; the samples come next.
+    fn ready(&mut self) {}
     /// Just before a DMA buffer is handed to the controller.
     fn chunk_begin(&mut self) {}
     /// Just after the controller returned from a buffer.
@@ -174,6 +176,20 @@ fn fnv(mut h: u32, values: &[f32]) -> u32 {
     h
 }
 
+/// The controller over `blob`, built out of line so that the temporaries of its construction
+/// leave the stack before the samples come.
+#[inline(never)]
+fn build<'a>(blob: &'a Blob<'a>) -> Result<BlobController<'a>, ControllerError> {
+    let gmm = blob.gmm();
+    Controller::new(
+        &blob.prosody_config(),
+        gmm.as_slice(),
+        blob.crf_weights(),
+        blob,
+        blob,
+    )
+}
+
 /// Runs a fresh controller from `blob` over `audio` (little-endian i16 at 16 kHz) in
 /// [`CHUNK`]-sample buffers, writing the trace for input `name` to `out`.
 pub fn run(
@@ -213,10 +229,13 @@ pub fn run(
     let duty_max = duty_cycle(PULSE_MAX_US, period_us, u16::MAX);
     let dt_s = 1.0 / blob.fps();
 
-    let gmm = blob.gmm();
-    let mut controller: BlobController<'_> =
-        Controller::new(&config, gmm.as_slice(), blob.crf_weights(), &blob, &blob)
-            .map_err(RunError::Controller)?;
+    // Used in place: unwrapping would move the controller (14 KiB) into a second stack slot.
+    let mut built = build(&blob);
+    let controller = match &mut built {
+        Ok(c) => c,
+        Err(e) => return Err(RunError::Controller(*e)),
+    };
+    probe.ready();
 
     writeln!(out, "input {name} samples={}", audio.len() / 2).map_err(|_| RunError::Output)?;
     let mut sum = Summary {

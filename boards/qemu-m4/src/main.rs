@@ -6,7 +6,8 @@
 //! noise, full-scale square wave). For each it runs a fresh `Controller` over the samples in
 //! 256-sample buffers ([`drive`], shared with the host reference) and prints the decision trace
 //! on semihosting stdout. On stderr it prints the peak stack (the stack is painted by
-//! `cortex-m-rt` before `main`; the lowest scrubbed word is the peak).
+//! `cortex-m-rt` before `main`; the lowest scrubbed word is the peak), split into building the
+//! controller and running it (the free stack is painted again in between).
 //!
 //! Exit status (semihosting `SYS_EXIT`): 0 when every input ran with valid poses; 1 on any
 //! error (blob refused, invalid pose, output failure), panic or fault.
@@ -91,15 +92,18 @@ fn exit(ok: bool) -> ! {
     cortex_m::asm::udf()
 }
 
-/// Bytes of stack ever used: from the top of RAM down to the lowest word that no longer holds
-/// the paint.
+extern "C" {
+    // Bounds of the stack region, from cortex-m-rt's linker script (the stack grows down from
+    // `_stack_start`; `_stack_end` is the end of the statics).
+    static _stack_start: u32;
+    static mut _stack_end: u32;
+}
+
+/// Bytes of stack used since the last painting: from the top of RAM down to the lowest word
+/// that no longer holds the paint (cortex-m-rt paints the whole region before `main`).
 fn peak_stack_bytes() -> usize {
-    extern "C" {
-        static _stack_start: u32;
-        static _stack_end: u32;
-    }
-    // SAFETY: both symbols come from cortex-m-rt's linker script and bound the stack region,
-    // which is RAM; it is read word by word (aligned, in range) below the live stack frame.
+    // SAFETY: the region between the two linker symbols is RAM; it is read word by word
+    // (aligned, in range).
     unsafe {
         let top = core::ptr::addr_of!(_stack_start) as usize;
         let mut p = core::ptr::addr_of!(_stack_end);
@@ -107,6 +111,40 @@ fn peak_stack_bytes() -> usize {
             p = p.add(1);
         }
         top - p as usize
+    }
+}
+
+/// Paints the free stack again, below this function's own frame, so that the next
+/// [`peak_stack_bytes`] sees only what runs from here on.
+#[cfg(not(feature = "measure"))]
+#[inline(never)]
+fn repaint_stack() {
+    let sp = cortex_m::register::msp::read() as usize;
+    // SAFETY: writes only below the current stack pointer (minus a margin), i.e. stack memory
+    // no live frame uses; interrupts are not enabled, so nothing else can be using it.
+    unsafe {
+        let mut p = core::ptr::addr_of_mut!(_stack_end);
+        let stop = (sp - 64) & !3;
+        while (p as usize) < stop {
+            core::ptr::write_volatile(p, cortex_m_rt::STACK_PAINT_VALUE);
+            p = p.add(1);
+        }
+    }
+}
+
+/// Splits the stack peak into building the controller and running it.
+#[cfg(not(feature = "measure"))]
+#[derive(Default)]
+struct StackProbe {
+    /// Peak while building (blob parse, controller), taken when the controller is ready.
+    build: usize,
+}
+
+#[cfg(not(feature = "measure"))]
+impl drive::Probe for StackProbe {
+    fn ready(&mut self) {
+        self.build = self.build.max(peak_stack_bytes());
+        repaint_stack();
     }
 }
 
@@ -122,9 +160,12 @@ fn main() -> ! {
     measure::blob_parse(&mut clock, BLOB, &mut out);
 
     let mut ok = true;
+    #[cfg(not(feature = "measure"))]
+    let mut stack = StackProbe::default();
+    let mut run_stack = 0;
     for (name, audio) in INPUTS.iter() {
         #[cfg(not(feature = "measure"))]
-        let result = drive::run(name, BLOB, audio, &mut out, &mut drive::NoProbe);
+        let result = drive::run(name, BLOB, audio, &mut out, &mut stack);
         #[cfg(feature = "measure")]
         let result = {
             let mut probe = measure::Timing::new(&mut clock);
@@ -134,6 +175,7 @@ fn main() -> ! {
             }
             r
         };
+        run_stack = run_stack.max(peak_stack_bytes());
         if let Err(e) = result {
             // Debug, not Display: the blob error's Display formats an f32 limit, which would
             // link about 15 KiB of float formatting into the firmware.
@@ -142,10 +184,15 @@ fn main() -> ! {
             break;
         }
     }
+    #[cfg(not(feature = "measure"))]
+    let build_stack = stack.build;
+    #[cfg(feature = "measure")]
+    let build_stack = 0;
     let _ = writeln!(
         err,
-        "memory peak_stack_bytes={} controller_bytes={} blob_bytes={}",
-        peak_stack_bytes(),
+        "memory peak_stack_bytes={} build_stack_bytes={build_stack} run_stack_bytes={run_stack} \
+         controller_bytes={} blob_bytes={}",
+        build_stack.max(run_stack),
         core::mem::size_of::<drive::BlobController<'static>>(),
         BLOB.len()
     );
