@@ -85,6 +85,13 @@ pub enum Command {
         #[arg(long, default_value_t = 10.0, value_parser = parse_chunk_ms)]
         chunk_ms: f64,
     },
+    /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
+    /// utterance, and `run` on it (about a minute).
+    Demo {
+        /// Output folder.
+        #[arg(long, value_name = "DIR", default_value = "gesture-demo")]
+        out: PathBuf,
+    },
     /// List the audio input devices.
     Devices,
     /// Run a policy blob on the microphone, printing decisions and the belief.
@@ -153,6 +160,9 @@ pub enum CliError {
     /// `live` or `devices` failed.
     #[error(transparent)]
     Live(#[from] LiveError),
+    /// `demo` failed.
+    #[error(transparent)]
+    Demo(#[from] crate::demo::DemoError),
 }
 
 impl From<RunError> for CliError {
@@ -169,6 +179,7 @@ impl CliError {
             Self::Config(_) | Self::Output(_) => 1,
             Self::Run(e) => e.exit_code(),
             Self::Live(e) => e.exit_code(),
+            Self::Demo(_) => 1,
         }
     }
 }
@@ -200,6 +211,11 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), CliError> {
             out,
         ),
         Command::Devices => Ok(live::devices(out)?),
+        Command::Demo { out: dir } => Ok(crate::demo::demo(
+            dir,
+            crate::demo::DemoParams::default(),
+            out,
+        )?),
         Command::Live {
             blob,
             device,

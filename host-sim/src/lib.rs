@@ -17,6 +17,7 @@
 //!   BVH, timeline, servo trace and previews written to a folder.
 //! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
 //!   [`live::AudioSource`] trait, with a fake source for tests.
+//! - [`demo`]: `gesture-sim demo`: synth, fit, pack, a new utterance and `run`, in one command.
 //! - [`servo`]: virtual PWM pins under the runtime's `ServoRig`.
 //! - [`skeleton`]: rig poses back on the library's skeleton (the blob's skeleton section).
 #![forbid(unsafe_code)]
@@ -24,6 +25,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod demo;
 pub mod eval;
 pub mod eval_cmd;
 pub mod live;

@@ -4,8 +4,9 @@
 //! skeleton's forward kinematics, front view: world X to the right, Y up, one scale for the
 //! strip), each with its time; the intensity curve over the whole audio with the syllables
 //! shaded and the figure times as grey lines, "enter" decisions as green ticks along the top;
-//! the belief as a heat strip (one row per state, dark = 0, yellow = 1, the belief held since
-//! the last step); a time axis in seconds.
+//! the belief as a heat strip (one row per state, the belief held since the last step; the
+//! colour is `sqrt(p)` on a dark-blue (0) to yellow (1) ramp, so the spread of a belief over
+//! many states still shows); a time axis in seconds.
 //!
 //! **The animation** (320 x 240, 10 frames per second): the stick figure over the same
 //! intensity and belief plot with a red cursor. At most [`GIF_MAX_FRAMES`] frames: a longer
@@ -89,9 +90,10 @@ fn palette() -> Vec<u8> {
     p
 }
 
+/// Ramp colour of probability `v` (`sqrt(v)`, see the module docs).
 fn ramp(v: f32) -> u8 {
     let v = if v.is_finite() {
-        v.clamp(0.0, 1.0)
+        v.clamp(0.0, 1.0).sqrt()
     } else {
         0.0
     };

@@ -1,0 +1,248 @@
+//! `gesture-sim demo [--out DIR]`: the whole pipeline in one command on a fresh clone, with
+//! nothing but the repository: a synthetic speech+motion corpus, an inference model trained on
+//! it, two policy blobs (the full skeleton for BVH output and the 8-servo puppet rig, whose rig
+//! file is built into the binary), a new utterance the model has never heard, and
+//! `gesture-sim run` on it with both blobs.
+//!
+//! Layout of `DIR` (default `gesture-demo`):
+//!
+//! ```text
+//! corpus/            take_NNN.wav + take_NNN.bvh, truth.json   (3 minutes, seed 1)
+//! model.json         the inference model (8 states, 8 clusters, window 4)
+//! character.blob     full-skeleton rig (BVH output), puppet.blob: rigs/puppet-8ch.toml
+//! puppet-8ch.toml    the rig file used
+//! utterance.wav      20 s of new synthetic speech (another seed and speaker)
+//! run-character/     motion.bvh, timeline.json, servo.csv, preview.png, preview.gif
+//! run-puppet/        the same for the puppet blob
+//! ```
+//!
+//! Progress bars go to stderr (hidden when it is not a terminal); the summary to stdout.
+//! Every step is seeded, so two demos write the same files (but for timings).
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use gesture_trainer::corpus::{load_corpus, LoadOptions};
+use gesture_trainer::inference::train::{fit, sequences, FitConfig};
+use gesture_trainer::pack::{pack, PackOptions};
+use gesture_trainer::synth::{write_corpus, SynthParams};
+
+use crate::run::{self as run_cmd, RunConfig};
+
+/// The sample rig, built in so the demo runs from any folder.
+pub const PUPPET_RIG: &str = include_str!("../../rigs/puppet-8ch.toml");
+
+/// Demo settings (the command uses the defaults; tests may shrink them).
+#[derive(Clone, Copy, Debug)]
+pub struct DemoParams {
+    /// Corpus length (minutes).
+    pub corpus_minutes: f64,
+    /// Utterance length (s).
+    pub utterance_s: f64,
+    /// Hidden states.
+    pub states: usize,
+}
+
+impl Default for DemoParams {
+    fn default() -> Self {
+        Self {
+            corpus_minutes: 3.0,
+            utterance_s: 20.0,
+            states: 8,
+        }
+    }
+}
+
+fn bar(len: u64, what: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new(len);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} ({elapsed})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    pb.set_message(what.to_string());
+    pb
+}
+
+fn spinner(what: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_message(what.to_string());
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
+/// Why the demo failed (one line; the step is named).
+#[derive(Debug, thiserror::Error)]
+#[error("demo, {step}: {reason}")]
+pub struct DemoError {
+    step: &'static str,
+    reason: String,
+}
+
+fn at<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> DemoError {
+    move |e| DemoError {
+        step,
+        reason: e.to_string(),
+    }
+}
+
+/// Runs the demo into `dir`, printing what it did to `out`.
+pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), DemoError> {
+    let start = Instant::now();
+    std::fs::create_dir_all(dir).map_err(at("creating the folder"))?;
+    let corpus = dir.join("corpus");
+    std::fs::create_dir_all(&corpus).map_err(at("creating the folder"))?;
+
+    // 1. Corpus.
+    let t = Instant::now();
+    let synth = SynthParams {
+        minutes: params.corpus_minutes,
+        seed: 1,
+        take_seconds: 60.0,
+    };
+    let takes = (synth.minutes * 60.0 / synth.take_seconds).ceil() as u64;
+    let pb = bar(takes, "corpus");
+    let written = write_corpus(&synth, &corpus, |done, _| pb.set_position(done as u64))
+        .map_err(at("synthesizing the corpus"))?;
+    pb.finish_and_clear();
+    let line = |out: &mut dyn Write, s: String| writeln!(out, "{s}").map_err(at("printing"));
+    line(
+        out,
+        format!(
+            "1. corpus: {} takes, {:.1} min of synthetic speech and upper-body motion, {} \
+             syllables, {} gesture segments -> {} ({:.1} s)",
+            written.takes,
+            synth.minutes,
+            written.syllables,
+            written.segments,
+            corpus.display(),
+            t.elapsed().as_secs_f64()
+        ),
+    )?;
+
+    // 2. Model.
+    let t = Instant::now();
+    let sp = spinner("fitting the HMM, the prosody GMM and the CRF");
+    let c = load_corpus(std::slice::from_ref(&corpus), &LoadOptions::default())
+        .map_err(at("loading the corpus"))?;
+    let (seqs, segs) = sequences(&c, None);
+    let cfg = FitConfig {
+        states: params.states,
+        clusters: 8,
+        window: 4,
+        restarts: 8,
+        ..FitConfig::default()
+    };
+    let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).map_err(at("fitting the model"))?;
+    let model_path = dir.join("model.json");
+    model.save(&model_path).map_err(at("writing the model"))?;
+    sp.finish_and_clear();
+    line(
+        out,
+        format!(
+            "2. model: {} -> {} ({:.1} s)",
+            model.summary,
+            model_path.display(),
+            t.elapsed().as_secs_f64()
+        ),
+    )?;
+
+    // 3. Blobs.
+    let t = Instant::now();
+    let rig_path = dir.join("puppet-8ch.toml");
+    std::fs::write(&rig_path, PUPPET_RIG).map_err(at("writing the rig file"))?;
+    let pb = bar(2, "packing");
+    let character = dir.join("character.blob");
+    let r1 = pack(
+        &model_path,
+        std::slice::from_ref(&corpus),
+        &PackOptions::default(),
+        &character,
+    )
+    .map_err(at("packing the full-skeleton blob"))?;
+    pb.inc(1);
+    let puppet = dir.join("puppet.blob");
+    let opts = PackOptions {
+        rig: Some(rig_path.clone()),
+        ..PackOptions::default()
+    };
+    let r2 = pack(&model_path, std::slice::from_ref(&corpus), &opts, &puppet)
+        .map_err(at("packing the puppet blob"))?;
+    pb.finish_and_clear();
+    line(
+        out,
+        format!(
+            "3. blobs: {} ({} bytes, {} channels, {} segments, {:.1}% of successors pruned), \
+             {} ({} bytes, {} servos) ({:.1} s)",
+            character.display(),
+            r1.blob_bytes,
+            r1.channels,
+            r1.segments,
+            100.0 * r1.pruned_fraction,
+            puppet.display(),
+            r2.blob_bytes,
+            r2.channels,
+            t.elapsed().as_secs_f64()
+        ),
+    )?;
+
+    // 4. A new utterance (another seed: another speaker and sentence).
+    let utter_dir = dir.join(".utterance");
+    std::fs::create_dir_all(&utter_dir).map_err(at("creating the folder"))?;
+    let up = SynthParams {
+        minutes: params.utterance_s / 60.0,
+        seed: 2024,
+        take_seconds: params.utterance_s,
+    };
+    write_corpus(&up, &utter_dir, |_, _| {}).map_err(at("synthesizing the utterance"))?;
+    let wav = dir.join("utterance.wav");
+    std::fs::rename(utter_dir.join("take_000.wav"), &wav).map_err(at("moving the utterance"))?;
+    let _ = std::fs::remove_dir_all(&utter_dir);
+    line(
+        out,
+        format!(
+            "4. utterance: {} ({:.0} s of new synthetic speech)",
+            wav.display(),
+            params.utterance_s
+        ),
+    )?;
+
+    // 5. Simulate with both blobs.
+    let runs: [(&str, &PathBuf); 2] = [("run-character", &character), ("run-puppet", &puppet)];
+    for (step, (name, blob)) in (5..).zip(runs) {
+        let cfg = RunConfig {
+            blob: blob.clone(),
+            audio: wav.clone(),
+            out: dir.join(name),
+            rig: None,
+            realtime: false,
+            chunk_ms: 10.0,
+        };
+        line(
+            out,
+            format!(
+                "{step}. gesture-sim run --blob {} --audio {} --out {}:",
+                blob.display(),
+                wav.display(),
+                cfg.out.display()
+            ),
+        )?;
+        let mut text = Vec::new();
+        run_cmd::run(&cfg, &mut text).map_err(at("simulating"))?;
+        for l in String::from_utf8_lossy(&text).lines() {
+            line(out, format!("   {l}"))?;
+        }
+    }
+    let d = dir.display();
+    line(
+        out,
+        format!(
+            "done in {:.1} s. Open {d}/run-character/preview.png (contact sheet), preview.gif \
+             (animation) and motion.bvh (Blender: File > Import > BVH); {d}/run-puppet/servo.csv \
+             is what the 8 servos of the puppet would be sent.",
+            start.elapsed().as_secs_f64(),
+        ),
+    )?;
+    Ok(())
+}
