@@ -11,6 +11,12 @@
 //!
 //! Memory is fixed: the front-end (about 9 KiB), a belief, the player and a few counters.
 //! Nothing allocates or panics; poses are finite.
+//!
+//! Building: [`Controller::new`] returns the controller (about 15 KiB) by value, which the
+//! compiler copies through stack temporaries on its way; [`Controller::new_in`] builds the same
+//! controller in place in a caller's `Option` (on the stack or in a `static`), the large tables
+//! written where they stay, so construction needs only a few KiB of stack beyond the controller
+//! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
 use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
@@ -91,6 +97,9 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
 
 impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
     /// A controller at the start of segment 0 with a uniform belief.
+    ///
+    /// The controller is about 15 KiB and is copied on the stack on its way out of here; a
+    /// board with little RAM builds it in place with [`new_in`](Self::new_in) instead.
     pub fn new(
         config: &ProsodyConfig,
         gmm: &[GmmComponent],
@@ -98,7 +107,44 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         tables: &'a T,
         lib: &'a L,
     ) -> Result<Self, ControllerError> {
-        let front_end = FrontEnd::new(config).map_err(ControllerError::FrontEnd)?;
+        let mut slot = None;
+        Self::new_in(&mut slot, config, gmm, crf, tables, lib)?;
+        slot.ok_or(ControllerError::Dimensions)
+    }
+
+    /// The controller [`new`](Self::new) returns, built in place in `slot` (on the caller's
+    /// stack or in a `static`) without a temporary copy: the big parts are written where they
+    /// stay. On an error `slot` is `None`.
+    pub fn new_in<'s>(
+        slot: &'s mut Option<Self>,
+        config: &ProsodyConfig,
+        gmm: &[GmmComponent],
+        crf: CrfWeights<'a>,
+        tables: &'a T,
+        lib: &'a L,
+    ) -> Result<&'s mut Self, ControllerError> {
+        let me = slot.insert(Self {
+            tables,
+            lib,
+            crf,
+            gmm: [GmmComponent::default(); MAX_CLUSTERS],
+            clusters: 0,
+            front_end: FrontEnd::blank(),
+            normalizer: StepNormalizer::new(),
+            belief: Belief::new(),
+            uniform: [0.0; MAX_STATES],
+            player: Player::new(),
+            exit: 0,
+            pose: [0.0; MAX_CHANNELS],
+            rate: 0,
+            fps_milli: 0,
+            samples: 0,
+            ticks: 0,
+        });
+        if let Err(e) = me.front_end.configure(config) {
+            *slot = None;
+            return Err(ControllerError::FrontEnd(e));
+        }
         let s = tables.states();
         let fps = lib.fps();
         if gmm.len() != crf.clusters
@@ -110,30 +156,20 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             || lib.channels() > MAX_CHANNELS
             || !(fps.is_finite() && fps > 0.0 && fps <= 1000.0)
         {
+            *slot = None;
             return Err(ControllerError::Dimensions);
         }
-        let mut comps = [GmmComponent::default(); MAX_CLUSTERS];
-        comps[..gmm.len()].copy_from_slice(gmm);
-        let mut uniform = [0.0; MAX_STATES];
-        uniform[..s].iter_mut().for_each(|v| *v = 1.0 / s as f32);
-        Ok(Self {
-            tables,
-            lib,
-            crf,
-            gmm: comps,
-            clusters: gmm.len(),
-            front_end,
-            normalizer: StepNormalizer::new(),
-            belief: Belief::new(),
-            uniform,
-            player: Player::new(),
-            exit: tables.first_exit(0),
-            pose: [0.0; MAX_CHANNELS],
-            rate: config.sample_rate_hz as u64,
-            fps_milli: libm::roundf(fps * 1000.0) as u64,
-            samples: 0,
-            ticks: 0,
-        })
+        me.gmm[..gmm.len()].copy_from_slice(gmm);
+        me.clusters = gmm.len();
+        me.uniform[..s].iter_mut().for_each(|v| *v = 1.0 / s as f32);
+        me.exit = tables.first_exit(0);
+        me.rate = config.sample_rate_hz as u64;
+        me.fps_milli = libm::roundf(fps * 1000.0) as u64;
+        // Re-borrow through the slot: `me` ends here.
+        match slot {
+            Some(me) => Ok(me),
+            None => Err(ControllerError::Dimensions),
+        }
     }
 
     /// The current belief (uniform before the first step).

@@ -267,3 +267,62 @@ fn garbage_audio_keeps_producing_valid_poses() {
         }
     }
 }
+
+#[test]
+fn new_in_builds_in_place_what_new_builds() {
+    let t = tables();
+    let lib = Lib { lens: [20, 12, 30] };
+    let init = [0u8; 4];
+    let mut trans = Vec::new();
+    for v in [400i16, -400, -400, 400] {
+        trans.extend_from_slice(&v.to_le_bytes());
+    }
+    let mut obs = Vec::new();
+    for v in [800i16, -800, -800, 800] {
+        obs.extend_from_slice(&v.to_le_bytes());
+    }
+    let crf = || {
+        CrfWeights::new(
+            2,
+            2,
+            1,
+            I16Table::new(&init, 1e-3, 2).unwrap(),
+            I16Table::new(&trans, 1e-3, 4).unwrap(),
+            I16Table::new(&obs, 1e-3, 4).unwrap(),
+        )
+        .unwrap()
+    };
+    let g = gmm();
+    let audio = speech(4.0);
+    // A slot that already holds a used controller: everything must be rebuilt.
+    let mut slot = Some(Controller::new(&ProsodyConfig::DEFAULT, &g, crf(), &t, &lib).unwrap());
+    if let Some(c) = slot.as_mut() {
+        c.push(&audio[..20_000], &mut |_| {});
+    }
+    let c = Controller::new_in(&mut slot, &ProsodyConfig::DEFAULT, &g, crf(), &t, &lib).unwrap();
+    let mut out = Vec::new();
+    let mut sink = |e: ControllerEvent<'_>| match e {
+        ControllerEvent::Decision { tick, decision } => {
+            out.push(Rec::Decision(tick, decision.exit, decision.choice))
+        }
+        ControllerEvent::Pose { tick, pose } => out.push(Rec::Pose(tick, pose.to_vec())),
+        ControllerEvent::Step { step, belief } => {
+            out.push(Rec::Step(step.end_frame, belief.to_vec()))
+        }
+        ControllerEvent::Frame(_) => {}
+    };
+    for ch in audio.chunks(333) {
+        c.push(ch, &mut sink);
+    }
+    assert_eq!(out, run(&audio, 333));
+
+    // Refused settings or dimensions leave the slot empty.
+    let mut bad = ProsodyConfig::DEFAULT;
+    bad.sample_rate_hz = 12_345;
+    assert!(Controller::new_in(&mut slot, &bad, &g, crf(), &t, &lib).is_err());
+    assert!(slot.is_none());
+    assert!(
+        Controller::new_in(&mut slot, &ProsodyConfig::DEFAULT, &g[..1], crf(), &t, &lib).is_err()
+    );
+    assert!(slot.is_none());
+}

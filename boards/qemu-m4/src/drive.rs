@@ -176,13 +176,18 @@ fn fnv(mut h: u32, values: &[f32]) -> u32 {
     h
 }
 
-/// The controller over `blob`, built out of line so that the temporaries of its construction
-/// leave the stack before the samples come.
+/// Builds the controller over `blob` in `slot`, in place and out of line, so that neither a
+/// copy of it nor the temporaries of its construction stay on the stack while samples run.
 #[inline(never)]
-fn build<'a>(blob: &'a Blob<'a>) -> Result<BlobController<'a>, ControllerError> {
+fn build<'s, 'a>(
+    slot: &'s mut Option<BlobController<'a>>,
+    blob: &'a Blob<'a>,
+) -> Result<&'s mut BlobController<'a>, ControllerError> {
     let gmm = blob.gmm();
-    Controller::new(
-        &blob.prosody_config(),
+    let config = blob.prosody_config();
+    Controller::new_in(
+        slot,
+        &config,
         gmm.as_slice(),
         blob.crf_weights(),
         blob,
@@ -229,12 +234,8 @@ pub fn run(
     let duty_max = duty_cycle(PULSE_MAX_US, period_us, u16::MAX);
     let dt_s = 1.0 / blob.fps();
 
-    // Used in place: unwrapping would move the controller (14 KiB) into a second stack slot.
-    let mut built = build(&blob);
-    let controller = match &mut built {
-        Ok(c) => c,
-        Err(e) => return Err(RunError::Controller(*e)),
-    };
+    let mut slot = None;
+    let controller = build(&mut slot, &blob).map_err(RunError::Controller)?;
     probe.ready();
 
     writeln!(out, "input {name} samples={}", audio.len() / 2).map_err(|_| RunError::Output)?;

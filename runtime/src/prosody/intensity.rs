@@ -40,6 +40,14 @@ struct Block {
 }
 
 impl Block {
+    /// All zero (`Block::default()`), as a constant.
+    const ZERO: Self = Self {
+        reference: 0,
+        sum: 0.0,
+        sum_sq: 0.0,
+        min: 0,
+        max: 0,
+    };
     const EMPTY: Self = Self {
         reference: 0,
         sum: 0.0,
@@ -84,6 +92,31 @@ impl Intensity {
     /// Sizes for a sample rate (must be a multiple of 1000 Hz) and a pitch floor.
     /// Returns `None` when the window does not fit the capacities.
     pub fn new(rate_hz: u32, floor_hz: f32) -> Option<Self> {
+        let mut me = Self::blank();
+        me.configure(rate_hz, floor_hz)?;
+        Some(me)
+    }
+
+    /// A placeholder to [`configure`](Self::configure) in place (not usable as is). Cheap to
+    /// build directly in its final place, unlike a finished value returned by value.
+    #[inline(always)]
+    pub(crate) fn blank() -> Self {
+        Self {
+            block_len: 0,
+            half_blocks: 0,
+            weights: [0.0; MAX_HALF_BLOCKS],
+            weight_sum: 0.0,
+            ring: [Block::ZERO; MAX_BLOCKS],
+            blocks: 0,
+            cur: Block::ZERO,
+            cur_n: 0,
+            scale: 0.0,
+        }
+    }
+
+    /// Sets every field as [`new`](Self::new) would, in place; `None` (with `self` left
+    /// unusable) when the window does not fit the capacities.
+    pub(crate) fn configure(&mut self, rate_hz: u32, floor_hz: f32) -> Option<()> {
         if rate_hz % 1000 != 0 || rate_hz == 0 {
             return None;
         }
@@ -92,11 +125,11 @@ impl Intensity {
         if half_blocks > MAX_HALF_BLOCKS || half_blocks == 0 {
             return None;
         }
-        let mut weights = [0.0f32; MAX_HALF_BLOCKS];
+        self.weights.fill(0.0);
         let beta = 2.0 * core::f64::consts::PI * core::f64::consts::PI + 0.5;
         let peak = bessel_i0(beta);
         let mut weight_sum = 0.0f64;
-        for (i, w) in weights.iter_mut().take(half_blocks).enumerate() {
+        for (i, w) in self.weights.iter_mut().take(half_blocks).enumerate() {
             let x = (i as f64 + 0.5) / half_ms;
             let root = libm::sqrt((1.0 - x * x).max(0.0));
             let v = bessel_i0(beta * root) / peak;
@@ -105,17 +138,15 @@ impl Intensity {
         }
         let block_len = rate_hz / 1000;
         let full_scale = 32768.0f64;
-        Some(Self {
-            block_len,
-            half_blocks,
-            weights,
-            weight_sum: (weight_sum * block_len as f64) as f32,
-            ring: [Block::default(); MAX_BLOCKS],
-            blocks: 0,
-            cur: Block::EMPTY,
-            cur_n: 0,
-            scale: (1.0 / (full_scale * full_scale * 4.0e-10)) as f32,
-        })
+        self.block_len = block_len;
+        self.half_blocks = half_blocks;
+        self.weight_sum = (weight_sum * block_len as f64) as f32;
+        self.ring.fill(Block::ZERO);
+        self.blocks = 0;
+        self.cur = Block::EMPTY;
+        self.cur_n = 0;
+        self.scale = (1.0 / (full_scale * full_scale * 4.0e-10)) as f32;
+        Some(())
     }
 
     /// Samples either side of the centre that a frame needs, in whole blocks.

@@ -225,36 +225,70 @@ pub struct FrontEnd {
 impl FrontEnd {
     /// A front-end for `config`, or why the config is refused.
     pub fn new(config: &ProsodyConfig) -> Result<Self, ConfigError> {
+        let mut me = Self::blank();
+        me.configure(config)?;
+        Ok(me)
+    }
+
+    /// A placeholder to [`configure`](Self::configure) in place (not usable as is). Cheap to
+    /// build directly in its final place (a front-end is about 9 KiB; one returned by value is
+    /// copied on the stack on its way).
+    #[inline(always)]
+    pub(crate) fn blank() -> Self {
+        Self {
+            config: ProsodyConfig::DEFAULT,
+            hop: 0,
+            pitch_hop: 0,
+            decimator: None,
+            delay: 0,
+            ring: [0.0; PITCH_RING],
+            produced: 0,
+            analyzer: PitchAnalyzer::blank(),
+            global: GlobalPeak::new(),
+            path: PathFinder::new(&ProsodyConfig::DEFAULT.pitch),
+            intensity: Intensity::blank(),
+            syllables: SyllableDetector::new(ProsodyConfig::DEFAULT.syllables),
+            next_pitch: 1,
+            limit: u32::MAX,
+            emitted: 0,
+            samples: 0,
+        }
+    }
+
+    /// Makes `self` what [`new`](Self::new) returns for `config`, in place; on an error `self`
+    /// is left unusable.
+    pub(crate) fn configure(&mut self, config: &ProsodyConfig) -> Result<(), ConfigError> {
         config.validate()?;
         let rate = config.sample_rate_hz;
         let p = &config.pitch;
         let decimate = rate > MIN_RATE_HZ;
         let pitch_rate = if decimate { rate / 2 } else { rate };
-        let analyzer = PitchAnalyzer::new(pitch_rate, *p).ok_or(ConfigError::PitchRange)?;
-        let intensity = Intensity::new(rate, p.floor_hz).ok_or(ConfigError::PitchRange)?;
+        self.analyzer
+            .configure(pitch_rate, *p)
+            .ok_or(ConfigError::PitchRange)?;
+        self.intensity
+            .configure(rate, p.floor_hz)
+            .ok_or(ConfigError::PitchRange)?;
         let s = &config.syllables;
-        Ok(Self {
-            config: *config,
-            hop: rate / 100,
-            pitch_hop: pitch_rate / 100,
-            decimator: if decimate {
-                Some(HalfBand::new())
-            } else {
-                None
-            },
-            delay: if decimate { HalfBand::DELAY as u64 } else { 0 },
-            ring: [0.0; PITCH_RING],
-            produced: 0,
-            analyzer,
-            global: GlobalPeak::new(),
-            path: PathFinder::new(p),
-            intensity,
-            syllables: SyllableDetector::new(*s),
-            next_pitch: 1,
-            limit: u32::MAX,
-            emitted: 0,
-            samples: 0,
-        })
+        self.config = *config;
+        self.hop = rate / 100;
+        self.pitch_hop = pitch_rate / 100;
+        self.decimator = if decimate {
+            Some(HalfBand::new())
+        } else {
+            None
+        };
+        self.delay = if decimate { HalfBand::DELAY as u64 } else { 0 };
+        self.ring.fill(0.0);
+        self.produced = 0;
+        self.global = GlobalPeak::new();
+        self.path = PathFinder::new(p);
+        self.syllables = SyllableDetector::new(*s);
+        self.next_pitch = 1;
+        self.limit = u32::MAX;
+        self.emitted = 0;
+        self.samples = 0;
+        Ok(())
     }
 
     /// The configuration in use.

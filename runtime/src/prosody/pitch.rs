@@ -165,6 +165,33 @@ pub struct PitchAnalyzer {
 impl PitchAnalyzer {
     /// Sizes for a pitch rate; returns `None` when the window does not fit the capacities.
     pub fn new(rate_hz: u32, params: PitchParams) -> Option<Self> {
+        let mut me = Self::blank();
+        me.configure(rate_hz, params)?;
+        Some(me)
+    }
+
+    /// A placeholder to [`configure`](Self::configure) in place (tables zero; not usable as
+    /// is). Cheap to build directly in its final place, unlike a finished analyzer returned by
+    /// value.
+    #[inline(always)]
+    pub(crate) fn blank() -> Self {
+        Self {
+            params: PitchParams::PRAAT,
+            rate: 0.0,
+            window_len: 0,
+            period: 0,
+            half_period: 0,
+            min_lag: 0,
+            max_lag: 0,
+            hann: [0.0; MAX_WINDOW],
+            window_r: [0.0; MAX_LAGS],
+            silent_ratio: 0.0,
+        }
+    }
+
+    /// Sets every field as [`new`](Self::new) would, in place; `None` (with `self` left
+    /// unusable) when the window does not fit the capacities.
+    pub(crate) fn configure(&mut self, rate_hz: u32, params: PitchParams) -> Option<()> {
         let rate = rate_hz as f32;
         let nominal = libm::floorf(3.0 * rate / params.floor_hz) as usize;
         let half = (nominal / 2).checked_sub(1)?;
@@ -179,34 +206,30 @@ impl PitchAnalyzer {
         if min_lag + 2 >= max_lag || period > half {
             return None;
         }
-        let mut hann = [0.0f32; MAX_WINDOW];
-        for (i, h) in hann.iter_mut().take(window_len).enumerate() {
+        self.hann.fill(0.0);
+        for (i, h) in self.hann.iter_mut().take(window_len).enumerate() {
             let phase = (i + 1) as f64 * 2.0 * core::f64::consts::PI / (window_len + 1) as f64;
             *h = (0.5 - 0.5 * libm::cos(phase)) as f32;
         }
-        let mut me = Self {
-            params,
-            rate,
-            window_len,
-            period,
-            half_period,
-            min_lag,
-            max_lag,
-            hann,
-            window_r: [1.0; MAX_LAGS],
-            silent_ratio: params.silence_threshold / (1.0 + params.voicing_threshold),
-        };
+        self.params = params;
+        self.rate = rate;
+        self.window_len = window_len;
+        self.period = period;
+        self.half_period = half_period;
+        self.min_lag = min_lag;
+        self.max_lag = max_lag;
+        self.silent_ratio = params.silence_threshold / (1.0 + params.voicing_threshold);
         let mut buf = [0.0f32; FFT_LEN];
-        buf[..window_len].copy_from_slice(&hann[..window_len]);
+        buf[..window_len].copy_from_slice(&self.hann[..window_len]);
         let mut r = [0.0f32; MAX_LAGS];
         autocorrelation(&mut buf, &mut r);
         if r[0] <= 0.0 {
             return None;
         }
-        for (wr, &v) in me.window_r.iter_mut().zip(r.iter()) {
+        for (wr, &v) in self.window_r.iter_mut().zip(r.iter()) {
             *wr = v / r[0];
         }
-        Some(me)
+        Some(())
     }
 
     /// Window length in samples (even).
