@@ -81,6 +81,47 @@ impl HalfBand {
         }
         Some(acc)
     }
+
+    /// Input samples that the next `outputs` outputs take (`outputs` >= 1).
+    #[inline]
+    pub fn inputs_for(&self, outputs: u64) -> u64 {
+        // An output comes on every second input; `odd` means the next input makes one.
+        2 * outputs - self.odd as u64
+    }
+
+    /// [`push`](Self::push) for each of `xs` (i16 samples, scaled by 1/32768 as the
+    /// front-end does), handing each output to `out`: the same arithmetic in a tight loop.
+    // Out of line: its own registers (inlined into a large caller, its state spills).
+    #[inline(never)]
+    pub fn push_slice(&mut self, xs: &[i16], out: &mut impl FnMut(f32)) {
+        let mut pos = self.pos;
+        let mut odd = self.odd;
+        for &s in xs {
+            let x = s as f32 * (1.0 / 32768.0);
+            self.hist[pos] = x;
+            self.hist[pos + TAPS] = x;
+            pos += 1;
+            if pos == TAPS {
+                pos = 0;
+            }
+            odd = !odd;
+            if odd {
+                continue;
+            }
+            // The last TAPS samples, oldest first.
+            let Some(w) = self.hist.get(pos..pos + TAPS) else {
+                continue;
+            };
+            let mut acc = 0.5 * w[CENTRE];
+            for (m, c) in self.coef.iter().enumerate() {
+                let k = 2 * m + 1;
+                acc += c * (w[CENTRE - k] + w[CENTRE + k]);
+            }
+            out(acc);
+        }
+        self.pos = pos;
+        self.odd = odd;
+    }
 }
 
 impl Default for HalfBand {

@@ -190,6 +190,37 @@ impl Intensity {
         }
     }
 
+    /// [`push`](Self::push) for each of `xs`, with the open block kept in registers.
+    // Out of line: its own registers (inlined into a large caller, its state spills).
+    #[inline(never)]
+    pub fn push_slice(&mut self, xs: &[i16]) {
+        let mut cur = self.cur;
+        let mut n = self.cur_n;
+        for &s in xs {
+            if n == 0 {
+                cur.reference = s;
+            }
+            let x = (s as i32 - cur.reference as i32) as f32;
+            cur.sum += x;
+            cur.sum_sq += x * x;
+            if s < cur.min {
+                cur.min = s;
+            }
+            if s > cur.max {
+                cur.max = s;
+            }
+            n += 1;
+            if n == self.block_len {
+                self.ring[(self.blocks % MAX_BLOCKS as u64) as usize] = cur;
+                self.blocks += 1;
+                cur = Block::EMPTY;
+                n = 0;
+            }
+        }
+        self.cur = cur;
+        self.cur_n = n;
+    }
+
     /// Intensity (dB) of the frame centred on the boundary before block `centre`.
     /// Blocks before the stream's start count as silence. Returns `None` if a needed block is
     /// not complete yet or has left the ring.

@@ -312,11 +312,55 @@ impl FrontEnd {
     }
 
     /// Feeds samples (any count); reports finished frames and steps through `sink`, in order.
+    ///
+    /// Exactly `push_one` (the per-sample step) per sample, done in runs: up to the sample whose
+    /// decimated output completes the next pitch window, the intensity blocks and the
+    /// decimator take the whole run in tight loops (same arithmetic, same order), then that
+    /// frame is analysed. This is most of the front-end's per-sample cost on a Cortex-M4.
     pub fn push(&mut self, samples: &[i16], sink: &mut impl FnMut(Event)) {
-        for &s in samples {
-            self.push_one(s, sink);
+        let mut rest = samples;
+        while !rest.is_empty() {
+            // Decimated samples until the next window is complete (at least one, as
+            // `push_one` checks only after producing one).
+            let outputs = self.needed().saturating_sub(self.produced).max(1);
+            let inputs = match &self.decimator {
+                Some(d) => d.inputs_for(outputs),
+                None => outputs,
+            };
+            let n = inputs.min(rest.len() as u64) as usize;
+            let (run, later) = rest.split_at(n);
+            self.intensity.push_slice(run);
+            self.pitch_input(run);
+            if n as u64 == inputs && self.produced >= self.needed() && self.next_pitch <= self.limit
+            {
+                self.analyse_frame(sink);
+            }
+            rest = later;
         }
         self.samples += samples.len() as u64;
+    }
+
+    /// Decimated samples needed before frame `next_pitch` can be analysed (its window is
+    /// complete): the decimated time index of the newest sample is `produced - 1 - delay`.
+    #[inline]
+    fn needed(&self) -> u64 {
+        let half = (self.analyzer.window_len() / 2) as u64;
+        self.next_pitch as u64 * self.pitch_hop as u64 + half + self.delay
+    }
+
+    /// Decimates `run` into the pitch ring (no analysis).
+    fn pitch_input(&mut self, run: &[i16]) {
+        let ring = &mut self.ring;
+        let mut produced = self.produced;
+        let mut store = |y: f32| {
+            ring[(produced % PITCH_RING as u64) as usize] = y;
+            produced += 1;
+        };
+        match &mut self.decimator {
+            Some(d) => d.push_slice(run, &mut store),
+            None => run.iter().for_each(|&s| store(s as f32 * (1.0 / 32768.0))),
+        }
+        self.produced = produced;
     }
 
     #[inline]
@@ -332,10 +376,7 @@ impl FrontEnd {
         };
         self.ring[(self.produced % PITCH_RING as u64) as usize] = y;
         self.produced += 1;
-        // Decimated time index of the newest sample is produced - 1 - delay.
-        let half = (self.analyzer.window_len() / 2) as u64;
-        let needed = self.next_pitch as u64 * self.pitch_hop as u64 + half + self.delay;
-        if self.produced >= needed && self.next_pitch <= self.limit {
+        if self.produced >= self.needed() && self.next_pitch <= self.limit {
             self.analyse_frame(sink);
         }
     }
@@ -350,9 +391,12 @@ impl FrontEnd {
         // Indices before the stream's start wrap to ring slots that still hold zeros.
         let first = (k * self.pitch_hop as u64 + self.delay) as i64 - half as i64;
         let mut win = [0.0f32; MAX_WINDOW];
-        for (i, w) in win.iter_mut().take(len).enumerate() {
-            *w = self.ring[(first + i as i64).rem_euclid(PITCH_RING as i64) as usize];
-        }
+        // At most two contiguous pieces of the ring (len <= MAX_WINDOW < PITCH_RING).
+        let start = first.rem_euclid(PITCH_RING as i64) as usize;
+        let len = len.min(MAX_WINDOW);
+        let head = (PITCH_RING - start).min(len);
+        win[..head].copy_from_slice(&self.ring[start..start + head]);
+        win[head..len].copy_from_slice(&self.ring[..len - head]);
         let mut cand = Candidates::UNVOICED;
         self.analyzer
             .analyze(&win[..len], &mut self.global, &mut cand);

@@ -255,6 +255,8 @@ impl PitchAnalyzer {
 
     /// Analyses one window of `window_len()` samples. `global` tracks the running peak.
     /// Returns the candidates with their path-finder scores.
+    // Out of line: once per frame, and its 3 KiB of buffers then stay off the caller's frame.
+    #[inline(never)]
     pub fn analyze(&self, x: &[f32], global: &mut GlobalPeak, out: &mut Candidates) {
         *out = Candidates::UNVOICED;
         if x.len() != self.window_len {
@@ -361,20 +363,32 @@ impl PitchAnalyzer {
 /// Autocorrelation `r[l] = sum_i x[i] x[i+l]` of `buf` (zero-padded signal, destroyed) for lags
 /// `0..r.len()`, via two real FFTs: the power spectrum is real and even, so its forward
 /// transform equals `FFT_LEN` times its inverse transform.
+///
+/// The power spectrum is built in `buf` itself (the FFT's output is `buf` seen as complex
+/// bins): power `2j` and `2j + 1` go into bin `j`, whose own values were used two steps of `j`
+/// earlier, so no second 2 KiB buffer is needed.
 fn autocorrelation(buf: &mut [f32; FFT_LEN], r: &mut [f32]) {
-    let mut power = [0.0f32; FFT_LEN];
-    {
+    let half = FFT_LEN / 2;
+    let nyquist = {
         let spec = rfft_512(buf);
+        let power = |c: &microfft::Complex32| c.re * c.re + c.im * c.im;
         // Bin 0 packs DC (re) and Nyquist (im).
-        power[0] = spec[0].re * spec[0].re;
-        power[FFT_LEN / 2] = spec[0].im * spec[0].im;
-        for k in 1..FFT_LEN / 2 {
-            let p = spec[k].re * spec[k].re + spec[k].im * spec[k].im;
-            power[k] = p;
-            power[FFT_LEN - k] = p;
+        let dc = spec[0].re * spec[0].re;
+        let nyquist = spec[0].im * spec[0].im;
+        spec[0].re = dc;
+        spec[0].im = power(&spec[1]);
+        for j in 1..half / 2 {
+            let (lo, hi) = (power(&spec[2 * j]), power(&spec[2 * j + 1]));
+            spec[j].re = lo;
+            spec[j].im = hi;
         }
+        nyquist
+    };
+    buf[half] = nyquist;
+    for k in 1..half {
+        buf[FFT_LEN - k] = buf[k];
     }
-    let ac = rfft_512(&mut power);
+    let ac = rfft_512(buf);
     let scale = 1.0 / FFT_LEN as f32;
     for (rv, c) in r.iter_mut().zip(ac.iter()) {
         *rv = c.re * scale;
