@@ -5,10 +5,14 @@
 //!   `DIR/stress.raw` (the same length in four equal parts: digital silence, the speech
 //!   amplified 16x into hard clipping, full-scale white noise from a fixed seed, and a
 //!   full-scale 200 Hz square wave from `i16::MIN` to `i16::MAX`).
+//!   Each also as a 16 kHz mono 16-bit WAV (`speech.wav`, `stress.wav`) for `gesture-sim run`.
 //! - `trace --blob BLOB --input NAME=FILE ...` prints the reference decision trace: the
 //!   firmware's own drive loop (`boards/qemu-m4/src/drive.rs`, included below) over the same
 //!   samples in the same 256-sample chunks, so its output must equal the firmware's stdout
 //!   byte for byte.
+//! - `sim-decisions --timeline timeline.json` prints the decisions of a `gesture-sim run`
+//!   (its `timeline.json`) as the trace's `decision` lines, for the same comparison against the
+//!   simulator itself.
 //!
 //! Exit status: 0 on success, 1 on any error (one line on stderr naming the file).
 
@@ -44,6 +48,12 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Print the decisions of a `gesture-sim run` timeline as trace lines.
+    SimDecisions {
+        /// `timeline.json` from `gesture-sim run`.
+        #[arg(long)]
+        timeline: PathBuf,
+    },
     /// Print the decision trace the firmware must print.
     Trace {
         /// The policy blob.
@@ -59,9 +69,24 @@ fn read(path: &Path) -> Result<Vec<u8>, String> {
     std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-fn write_raw(path: &Path, samples: &[i16]) -> Result<(), String> {
+/// Writes `samples` as `DIR/NAME.raw` (i16 LE) and `DIR/NAME.wav` (16 kHz mono 16-bit).
+fn write_input(dir: &Path, name: &str, samples: &[i16]) -> Result<(), String> {
+    let raw = dir.join(format!("{name}.raw"));
     let bytes: Vec<u8> = samples.iter().flat_map(|s| s.to_le_bytes()).collect();
-    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+    std::fs::write(&raw, bytes).map_err(|e| format!("{}: {e}", raw.display()))?;
+    let wav = dir.join(format!("{name}.wav"));
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: drive::AUDIO_RATE_HZ,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let fail = |e: hound::Error| format!("{}: {e}", wav.display());
+    let mut w = hound::WavWriter::create(&wav, spec).map_err(fail)?;
+    for &s in samples {
+        w.write_sample(s).map_err(fail)?;
+    }
+    w.finalize().map_err(fail)
 }
 
 /// The stress input: silence, clipping, white noise and a full-scale square wave, each a
@@ -104,8 +129,31 @@ fn audio(wav: &Path, seconds: f64, out: &Path) -> Result<(), String> {
     let n = ((seconds * drive::AUDIO_RATE_HZ as f64) as usize).min(pcm.samples.len());
     let speech = &pcm.samples[..n];
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
-    write_raw(&out.join("speech.raw"), speech)?;
-    write_raw(&out.join("stress.raw"), &stress(speech))
+    write_input(out, "speech", speech)?;
+    write_input(out, "stress", &stress(speech))
+}
+
+fn sim_decisions(timeline: &Path) -> Result<(), String> {
+    let text =
+        std::fs::read_to_string(timeline).map_err(|e| format!("{}: {e}", timeline.display()))?;
+    let bad = |what: &str| format!("{}: {what}", timeline.display());
+    let json: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(&e.to_string()))?;
+    let decisions = json["decisions"]
+        .as_array()
+        .ok_or_else(|| bad("no \"decisions\" array"))?;
+    for d in decisions {
+        let (Some(tick), Some(exit), Some(choice)) =
+            (d["tick"].as_u64(), d["exit"].as_u64(), d["choice"].as_str())
+        else {
+            return Err(bad(&format!("malformed decision {d}")));
+        };
+        match (choice, d["segment"].as_u64()) {
+            ("continue", _) => println!("decision tick={tick} exit={exit} choice=continue"),
+            ("enter", Some(c)) => println!("decision tick={tick} exit={exit} choice=segment {c}"),
+            _ => return Err(bad(&format!("malformed decision {d}"))),
+        }
+    }
+    Ok(())
 }
 
 fn trace(blob: &Path, inputs: &[String]) -> Result<(), String> {
@@ -127,6 +175,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Audio { wav, seconds, out } => audio(wav, *seconds, out),
+        Command::SimDecisions { timeline } => sim_decisions(timeline),
         Command::Trace { blob, inputs } => trace(blob, inputs),
     };
     match result {
