@@ -193,20 +193,26 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         struct Rows<'a> {
             rows: &'a [Row],
         }
-        println!("{}", serde_json::to_string(&Rows { rows: &rows })?);
+        outln!("{}", serde_json::to_string(&Rows { rows: &rows })?);
         return Ok(());
     }
-    println!("mean log-likelihood per test step of the true kinematic parameters");
-    println!(
+    outln!("mean log-likelihood per test step of the true kinematic parameters");
+    outln!(
         "{:>6} {:>10} {:>10} {:>10}",
-        "window", "crf", "hmm", "prior"
+        "window",
+        "crf",
+        "hmm",
+        "prior"
     );
     for r in &rows {
-        println!(
+        outln!(
             "{:>6} {:>10.3} {:>10.3} {:>10.3}",
-            r.window, r.crf, r.hmm, r.prior
+            r.window,
+            r.crf,
+            r.hmm,
+            r.prior
         );
     }
-    println!("{extras}");
+    outln!("{extras}");
     Ok(())
 }

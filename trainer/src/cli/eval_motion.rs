@@ -189,19 +189,24 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
 pub fn run(a: &EvalMotionArgs) -> Result<(), CliError> {
     let rows = evaluate(a)?;
     if a.json {
-        println!(
+        outln!(
             "{}",
             serde_json::to_string(&serde_json::json!({ "rows": rows }))?
         );
         return Ok(());
     }
-    println!(
+    outln!(
         "{:<11} {:>9} {:>12} {:>10} {:>8} {:>10}",
-        "method", "hellinger", "mean_jerk", "jump_cuts", "cuts/s", "beat_align"
+        "method",
+        "hellinger",
+        "mean_jerk",
+        "jump_cuts",
+        "cuts/s",
+        "beat_align"
     );
     for r in &rows {
         let m = &r.metrics;
-        println!(
+        outln!(
             "{:<11} {:>9} {:>12.0} {:>10.2} {:>8.2} {:>10.3}",
             r.method,
             m.hellinger.map_or("-".into(), |h| format!("{h:.3}")),

@@ -66,7 +66,7 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
     let cfg = a.model.config(a.window);
     let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;
     model.save(&a.out)?;
-    println!(
+    outln!(
         "wrote {}: {}; fit {:.2} s (hmm {:.2}, gmm {:.2}, crf {:.2}), total {:.2} s",
         a.out.display(),
         model.summary,

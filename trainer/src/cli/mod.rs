@@ -1,6 +1,20 @@
 //! The `gesture-train` command line: argument parsing into validated settings and dispatch to
-//! the library. Every command prints what it did to stdout and progress to stderr; errors are
+//! the library. Output goes through [`outln!`], which ends the process quietly (status 0) when
+//! stdout is a closed pipe (`gesture-train ... | head`) instead of panicking like `println!`. Every command prints what it did to stdout and progress to stderr; errors are
 //! one line, and the binary exits with status 2 on any error.
+
+/// `println!` that exits with status 0 when stdout is a closed pipe.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut out = std::io::stdout().lock();
+        if let Err(e) = writeln!(out, $($arg)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+        }
+    }};
+}
 
 pub mod eval_inference;
 pub mod eval_motion;

@@ -44,7 +44,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         ..PackOptions::default()
     };
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
-    println!(
+    outln!(
         "wrote {}: {} bytes (front-end {}, inference {}, policy {}, library {}, rig {}, \
          skeleton {})",
         a.out.display(),
@@ -56,11 +56,15 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.section_bytes.rig,
         r.section_bytes.skeleton
     );
-    println!(
+    outln!(
         "library: {} segments, {} exit points, {} frames; rig {} ({} channels)",
-        r.segments, r.exit_points, r.frames, r.rig, r.channels
+        r.segments,
+        r.exit_points,
+        r.frames,
+        r.rig,
+        r.channels
     );
-    println!(
+    outln!(
         "successors: {} of {} kept ({:.2}% pruned{}); regret {:.4}%, agreement {:.2}% over {} simulated decisions",
         r.entries_kept,
         r.entries_total,
@@ -71,7 +75,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         100.0 * r.agreement,
         r.regret_decisions
     );
-    println!(
+    outln!(
         "time: load {:.2} s, costs {:.2} s, value iteration {:.2} s, pruning {:.2} s, write {:.2} s, total {:.2} s",
         r.timings.load_s,
         r.timings.costs_s,

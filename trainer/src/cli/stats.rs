@@ -181,13 +181,13 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
             "normalization": norm,
             "elapsed_s": elapsed,
         });
-        println!("{v}");
+        outln!("{v}");
         return Ok(());
     }
     let names = ["T (s)", "D", "V (/s)", "A (/s2)", "C (1/u)", "H"];
     for s in &stats {
-        println!("{}  ({})", s.stem, s.files.join(" + "));
-        println!(
+        outln!("{}  ({})", s.stem, s.files.join(" + "));
+        outln!(
             "  duration: motion {} s, audio {} s; {} frames at {} fps",
             opt(s.motion_s, 2),
             opt(s.audio_s, 2),
@@ -195,10 +195,10 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
             opt(s.fps, 1)
         );
         if !s.effectors.is_empty() {
-            println!("  effectors: {}", s.effectors.join(", "));
+            outln!("  effectors: {}", s.effectors.join(", "));
         }
         if let (Some(n), Some(q)) = (s.segments, s.segment_s) {
-            println!(
+            outln!(
                 "  segments: {n} (threshold {} /s); duration s: min {:.2}  q25 {:.2}  median {:.2}  q75 {:.2}  max {:.2}",
                 opt(s.threshold, 1),
                 q[0],
@@ -214,11 +214,11 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
                 .zip(k.iter())
                 .map(|(n, [m, sd])| format!("{n} {m:.3}±{sd:.3}"))
                 .collect();
-            println!("  kinematics (mean±sd): {}", parts.join("  "));
+            outln!("  kinematics (mean±sd): {}", parts.join("  "));
         }
         if let Some(n) = s.syllables {
             let per_s = s.audio_s.map(|d| n as f64 / d.max(1e-9));
-            println!(
+            outln!(
                 "  syllables: {n} ({} /s), pause steps: {}",
                 opt(per_s, 2),
                 s.pauses.unwrap_or(0)
@@ -236,7 +236,7 @@ pub fn run(a: &StatsArgs) -> Result<(), CliError> {
         .fold(0.0, |a, b| a + b);
     let segs: usize = stats.iter().filter_map(|s| s.segments).sum();
     let syl: usize = stats.iter().filter_map(|s| s.syllables).sum();
-    println!(
+    outln!(
         "total: {} files, motion {:.1} s, audio {:.1} s, {segs} segments, {syl} syllables; read in {elapsed:.2} s",
         stats.len(),
         total_motion,

@@ -48,7 +48,7 @@ pub fn run(a: &SynthArgs) -> Result<(), CliError> {
         pb.set_position(done as u64);
     })?;
     pb.finish_and_clear();
-    println!(
+    outln!(
         "wrote {} takes ({:.1} min) to {}: {} planted syllables, {} gesture segments, \
          {} states; truth in {} ({:.1} s)",
         w.takes,
