@@ -1,7 +1,8 @@
 //! The `gesture-train` command line: argument parsing into validated settings and dispatch to
-//! the library. Output goes through the `outln!` macro, which ends the process quietly (status 0) when
-//! stdout is a closed pipe (`gesture-train ... | head`) instead of panicking like `println!`. Every command prints what it did to stdout and progress to stderr; errors are
-//! one line, and the binary exits with status 2 on any error.
+//! the library. Every command prints what it did to stdout and progress to stderr; errors are
+//! one line, and the binary exits with status 2 on any error. Output goes through the `outln!`
+//! macro, which ends the process quietly (status 0) when stdout is a closed pipe
+//! (`gesture-train ... | head`) instead of panicking like `println!`.
 
 /// `println!` that exits with status 0 when stdout is a closed pipe.
 macro_rules! outln {
