@@ -55,14 +55,7 @@ impl Default for DemoParams {
 }
 
 fn bar(len: u64, what: &str) -> indicatif::ProgressBar {
-    let pb = indicatif::ProgressBar::new(len);
-    pb.set_style(
-        indicatif::ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} ({elapsed})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_message(what.to_string());
-    pb
+    gesture_trainer::cli::progress_bar(len, what)
 }
 
 fn spinner(what: &str) -> indicatif::ProgressBar {

@@ -136,8 +136,9 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// A progress bar on stderr (hidden when stderr is not a terminal).
-pub(crate) fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
+/// A progress bar on stderr (hidden when stderr is not a terminal); the style every command
+/// of both binaries uses.
+pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
     let pb = indicatif::ProgressBar::new(len);
     pb.set_style(
         indicatif::ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} ({elapsed})")

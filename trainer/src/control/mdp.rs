@@ -128,6 +128,21 @@ pub fn step_counts(lib: &Library, p: &MdpParams) -> (Vec<usize>, Vec<Option<usiz
     (enter, cont)
 }
 
+/// Step counts (see [`step_counts`]) and the powers of `p` they need.
+type Propagation = (Vec<usize>, Vec<Option<usize>>, Vec<Vec<Vec<f64>>>);
+
+fn propagation(lib: &Library, p: &[Vec<f64>], params: &MdpParams) -> Propagation {
+    let (enter, cont) = step_counts(lib, params);
+    let max_n = enter
+        .iter()
+        .chain(cont.iter().flatten())
+        .copied()
+        .max()
+        .unwrap_or(0);
+    let pw = powers(p, max_n);
+    (enter, cont, pw)
+}
+
 fn propagate(pn: &[Vec<f64>], q: &[f64]) -> Vec<f64> {
     pn.iter()
         .map(|row| row.iter().zip(q).map(|(a, b)| a * b).sum())
@@ -143,14 +158,7 @@ pub fn solve(
     params: &MdpParams,
 ) -> Policy {
     let s = p.len();
-    let (enter, cont) = step_counts(lib, params);
-    let max_n = enter
-        .iter()
-        .chain(cont.iter().flatten())
-        .copied()
-        .max()
-        .unwrap_or(0);
-    let pw = powers(p, max_n);
+    let (enter, cont, pw) = propagation(lib, p, params);
     let n_seg = lib.segments.len();
     let n_exit = lib.exits.len();
     let mut q = vec![vec![0.0; s]; n_exit];
@@ -257,14 +265,7 @@ pub fn unfactorized_q(
     sweeps: usize,
 ) -> Vec<Vec<f64>> {
     let s = p.len();
-    let (enter, cont) = step_counts(lib, params);
-    let max_n = enter
-        .iter()
-        .chain(cont.iter().flatten())
-        .copied()
-        .max()
-        .unwrap_or(0);
-    let pw = powers(p, max_n);
+    let (enter, cont, pw) = propagation(lib, p, params);
     let mut q = vec![vec![0.0; s]; lib.exits.len()];
     for _ in 0..sweeps {
         let mut v = vec![vec![vec![0.0; s]; lib.segments.len()]; lib.exits.len()];
