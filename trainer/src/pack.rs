@@ -148,7 +148,7 @@ fn policy_section(
     let owned = OwnedPolicy::new(&PolicyInput {
         states: model.states(),
         segments: lib.segments.len(),
-        discount: cm_discount(cm),
+        discount: cm.policy.discount,
         u: &q.u,
         u_cont: &q.u_cont,
         exits: &exits,
@@ -156,10 +156,6 @@ fn policy_section(
         succ_cost_scale: q.succ_scale,
     })?;
     Ok((owned, q))
-}
-
-fn cm_discount(_cm: &ControlModel) -> f64 {
-    crate::control::MdpParams::default().discount
 }
 
 fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, PackError> {

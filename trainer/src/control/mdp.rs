@@ -94,6 +94,8 @@ pub struct Policy {
     pub succ: Vec<Vec<f64>>,
     /// `Q[e][s]`.
     pub q: Vec<Vec<f64>>,
+    /// Discount per decision the values were computed with.
+    pub discount: f64,
     /// Value-iteration sweeps.
     pub iterations: usize,
     /// Largest change in the last sweep.
@@ -216,6 +218,7 @@ pub fn solve(
         u_cont,
         succ,
         q,
+        discount: params.discount,
         iterations,
         residual,
     }
