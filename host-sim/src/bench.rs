@@ -73,6 +73,7 @@ pub fn measure(
         let mut sink = |e: Event| match e {
             Event::Frame(_) => f += 1,
             Event::Step(_) => s += 1,
+            Event::Onset(_) => {}
         };
         let start = Instant::now();
         let mut fe = FrontEnd::new(config)?;

@@ -325,7 +325,7 @@ pub fn live_loop(
                     stats.ticks = tick + 1;
                     Ok(())
                 }
-                ControllerEvent::Frame(_) => Ok(()),
+                ControllerEvent::Frame(_) | ControllerEvent::Onset(_) => Ok(()),
             };
             if let (Err(e), None) = (r, &io_err) {
                 io_err = Some(e);

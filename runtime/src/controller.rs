@@ -9,6 +9,14 @@
 //! current frame of the current segment; if that frame is the current exit point, the policy
 //! decides with the belief as it stands.
 //!
+//! **Decisions on syllable onsets** ([`DecisionTiming`]). By default, decisions are timed
+//! against the speech, so that new gestures start with syllables: an interruption exit is only
+//! decided at when a syllable onset was detected within the last `onset_window_ms` (otherwise
+//! the segment plays on, as if the policy had chosen to continue), and at a segment's end the
+//! player holds the last frame until an onset arrives, for at most `max_wait_ms`, before
+//! deciding. [`DecisionTiming::IMMEDIATE`] decides at every exit point as soon as it is
+//! reached (the paper's controller). Onsets come from the front-end ([`Event::Onset`]).
+//!
 //! Memory is fixed: the front-end (about 9 KiB), a belief, the player and a few counters.
 //! Nothing allocates or panics; poses are finite.
 //!
@@ -24,6 +32,39 @@ use crate::inference::{
 use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
 use crate::policy::{select, Choice, Decision, PolicyTables};
 use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
+
+/// When the controller decides at exit points (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DecisionTiming {
+    /// Whether decisions wait for syllable onsets; `false` decides at every exit at once.
+    pub sync_to_onsets: bool,
+    /// An onset detected this recently (ms) counts as "now".
+    pub onset_window_ms: u32,
+    /// Longest hold (ms) at a segment's end while waiting for an onset.
+    pub max_wait_ms: u32,
+}
+
+impl DecisionTiming {
+    /// Decisions on onsets: an onset within 50 ms, a hold of at most 300 ms at segment ends
+    /// (chosen on held-out speech with `gesture-train eval-motion`; see the README).
+    pub const DEFAULT: Self = Self {
+        sync_to_onsets: true,
+        onset_window_ms: 50,
+        max_wait_ms: 300,
+    };
+    /// Every exit point decides as soon as it is reached.
+    pub const IMMEDIATE: Self = Self {
+        sync_to_onsets: false,
+        onset_window_ms: 0,
+        max_wait_ms: 0,
+    };
+}
+
+impl Default for DecisionTiming {
+    fn default() -> Self {
+        Self::DEFAULT
+    }
+}
 
 /// What the controller reports, in time order.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,7 +91,13 @@ pub enum ControllerEvent<'a> {
         tick: u64,
         /// Channel values.
         pose: &'a [f32],
+        /// Library segment played (the target of a blend during one).
+        segment: usize,
+        /// Frame of that segment played.
+        frame: usize,
     },
+    /// A syllable onset was detected (its start frame, 10 ms frames as in [`Frame`]).
+    Onset(u32),
 }
 
 /// Why a controller could not be built.
@@ -93,6 +140,11 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     fps_milli: u64,
     samples: u64,
     ticks: u64,
+    timing: DecisionTiming,
+    /// Tick at which the last onset was detected (the tick due next when it arrived).
+    last_onset: Option<u64>,
+    /// Ticks held at the current end exit, waiting for an onset.
+    waited: u64,
 }
 
 impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
@@ -140,6 +192,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             fps_milli: 0,
             samples: 0,
             ticks: 0,
+            timing: DecisionTiming::DEFAULT,
+            last_onset: None,
+            waited: 0,
         });
         if let Err(e) = me.front_end.configure(config) {
             *slot = None;
@@ -180,6 +235,22 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         } else {
             self.belief.probs(s)
         }
+    }
+
+    /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
+    pub fn set_timing(&mut self, timing: DecisionTiming) {
+        self.timing = timing;
+    }
+
+    /// When decisions happen.
+    pub fn timing(&self) -> DecisionTiming {
+        self.timing
+    }
+
+    /// Whether `ticks` ticks last at least `ms` milliseconds.
+    fn ticks_reach_ms(&self, ticks: u64, ms: u32) -> bool {
+        // ticks / (fps_milli / 1000) * 1000 >= ms
+        ticks.saturating_mul(1_000_000) >= (ms as u64).saturating_mul(self.fps_milli)
     }
 
     /// Samples needed before tick `k` is due.
@@ -234,8 +305,13 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             &self.crf,
             self.tables.states(),
         );
+        let (last_onset, now) = (&mut self.last_onset, self.ticks);
         let mut on_event = |ev| match ev {
             Event::Frame(f) => sink(ControllerEvent::Frame(f)),
+            Event::Onset(frame) => {
+                *last_onset = Some(now);
+                sink(ControllerEvent::Onset(frame));
+            }
             Event::Step(step) => {
                 let x = normalizer.push(&step);
                 let mut m = [0.0f32; MAX_CLUSTERS];
@@ -255,17 +331,38 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
 
     fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
         let played = self.player.frame();
+        let segment = self.player.segment();
         self.player.tick(self.lib, &mut self.pose);
         let tick = self.ticks;
         self.ticks += 1;
         sink(ControllerEvent::Pose {
             tick,
             pose: &self.pose[..self.lib.channels().min(MAX_CHANNELS)],
+            segment,
+            frame: played.min(self.lib.segment_len(segment).max(1) - 1),
         });
         let e = self.exit;
-        if self.tables.exit_segment(e) == self.player.segment()
-            && played >= self.tables.exit_frame(e)
-        {
+        if self.tables.exit_segment(e) == segment && played >= self.tables.exit_frame(e) {
+            let t = self.timing;
+            let fresh = !t.sync_to_onsets
+                || self.last_onset.is_some_and(|o| {
+                    !self.ticks_reach_ms(tick.saturating_sub(o), t.onset_window_ms)
+                });
+            if !fresh {
+                if !self.tables.exit_is_end(e) {
+                    // No onset now: play on past this interruption frame.
+                    if e + 1 < self.tables.exit_count() {
+                        self.exit = e + 1;
+                    }
+                    return;
+                }
+                if !self.ticks_reach_ms(self.waited, t.max_wait_ms) {
+                    // Hold the segment's last frame until an onset (or the wait runs out).
+                    self.waited += 1;
+                    return;
+                }
+            }
+            self.waited = 0;
             let decision = select(self.tables, e, self.belief());
             match decision.choice {
                 Choice::Continue => {

@@ -1,7 +1,8 @@
 //! The Controller over small in-memory tables: chunking invariance, decisions exactly at exit
-//! frames, finite poses, a blend at cuts, garbage audio never breaking it.
+//! frames, finite poses, a blend at cuts, garbage audio never breaking it, decisions timed on
+//! syllable onsets.
 
-use gesture_runtime::controller::{Controller, ControllerEvent};
+use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::{CrfWeights, GmmComponent, I16Table};
 use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::{Choice, PolicyTables};
@@ -122,6 +123,8 @@ enum Rec {
     Decision(u64, usize, Choice),
     Pose(u64, Vec<f32>),
     Step(u32, Vec<f32>),
+    /// An onset (its frame) reported before the pose of this tick.
+    Onset(u64, u32),
 }
 
 fn run(audio: &[i16], chunk: usize) -> Vec<Rec> {
@@ -129,6 +132,10 @@ fn run(audio: &[i16], chunk: usize) -> Vec<Rec> {
 }
 
 fn run_with(audio: &[i16], chunk: usize, finish: bool) -> Vec<Rec> {
+    run_timed(audio, chunk, finish, DecisionTiming::DEFAULT)
+}
+
+fn run_timed(audio: &[i16], chunk: usize, finish: bool, timing: DecisionTiming) -> Vec<Rec> {
     let t = tables();
     let lib = Lib { lens: [20, 12, 30] };
     let crf_bytes_init = [0u8; 4];
@@ -151,15 +158,22 @@ fn run_with(audio: &[i16], chunk: usize, finish: bool) -> Vec<Rec> {
     .unwrap();
     let g = gmm();
     let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &lib).unwrap();
+    assert_eq!(c.timing(), DecisionTiming::DEFAULT);
+    c.set_timing(timing);
     let mut out = Vec::new();
+    let mut next_tick = 0u64;
     let mut sink = |e: ControllerEvent<'_>| match e {
         ControllerEvent::Decision { tick, decision } => {
             out.push(Rec::Decision(tick, decision.exit, decision.choice))
         }
-        ControllerEvent::Pose { tick, pose } => out.push(Rec::Pose(tick, pose.to_vec())),
+        ControllerEvent::Pose { tick, pose, .. } => {
+            next_tick = tick + 1;
+            out.push(Rec::Pose(tick, pose.to_vec()))
+        }
         ControllerEvent::Step { step, belief } => {
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
         }
+        ControllerEvent::Onset(frame) => out.push(Rec::Onset(next_tick, frame)),
         ControllerEvent::Frame(_) => {}
     };
     for ch in audio.chunks(chunk.max(1)) {
@@ -182,7 +196,9 @@ fn finish_reports_the_last_steps_without_a_tick() {
     let extra = &done[open.len()..];
     assert!(!extra.is_empty());
     assert!(
-        extra.iter().all(|r| matches!(r, Rec::Step(..))),
+        extra
+            .iter()
+            .all(|r| matches!(r, Rec::Step(..) | Rec::Onset(..))),
         "{extra:?}"
     );
     for r in extra {
@@ -212,7 +228,7 @@ fn chunking_does_not_change_decisions_or_poses() {
 #[test]
 fn one_pose_per_tick_and_decisions_at_exit_frames() {
     let audio = speech(4.0);
-    let recs = run(&audio, 1000);
+    let recs = run_timed(&audio, 1000, false, DecisionTiming::IMMEDIATE);
     let poses: Vec<&Vec<f32>> = recs
         .iter()
         .filter_map(|r| {
@@ -264,6 +280,7 @@ fn garbage_audio_keeps_producing_valid_poses() {
                 assert!((s - 1.0).abs() < 1e-4 && b.iter().all(|v| v.is_finite()));
             }
             Rec::Decision(_, e, _) => assert!(e < 5),
+            Rec::Onset(..) => {}
         }
     }
 }
@@ -305,16 +322,20 @@ fn new_in_builds_in_place_what_new_builds() {
         ControllerEvent::Decision { tick, decision } => {
             out.push(Rec::Decision(tick, decision.exit, decision.choice))
         }
-        ControllerEvent::Pose { tick, pose } => out.push(Rec::Pose(tick, pose.to_vec())),
+        ControllerEvent::Pose { tick, pose, .. } => out.push(Rec::Pose(tick, pose.to_vec())),
         ControllerEvent::Step { step, belief } => {
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
         }
-        ControllerEvent::Frame(_) => {}
+        ControllerEvent::Onset(_) | ControllerEvent::Frame(_) => {}
     };
     for ch in audio.chunks(333) {
         c.push(ch, &mut sink);
     }
-    assert_eq!(out, run(&audio, 333));
+    let expected: Vec<Rec> = run(&audio, 333)
+        .into_iter()
+        .filter(|r| !matches!(r, Rec::Onset(..)))
+        .collect();
+    assert_eq!(out, expected);
 
     // Refused settings or dimensions leave the slot empty.
     let mut bad = ProsodyConfig::DEFAULT;
@@ -325,4 +346,100 @@ fn new_in_builds_in_place_what_new_builds() {
         Controller::new_in(&mut slot, &ProsodyConfig::DEFAULT, &g[..1], crf(), &t, &lib).is_err()
     );
     assert!(slot.is_none());
+}
+
+/// Exit points of `tables()`: `(segment, frame, end)`.
+const EXITS: [(usize, usize, bool); 5] = [
+    (0, 9, false),
+    (0, 19, true),
+    (1, 11, true),
+    (2, 14, false),
+    (2, 29, true),
+];
+
+#[test]
+fn in_silence_interruptions_pass_and_segment_ends_hold_for_the_longest_wait() {
+    // No speech, no onsets: interruption exits are passed without deciding, and each segment
+    // end holds its last frame for 300 ms (9 ticks at 30 fps) before deciding.
+    let recs = run(&vec![0i16; 16_000 * 4], 500);
+    assert!(!recs.iter().any(|r| matches!(r, Rec::Onset(..))));
+    let decisions: Vec<(u64, usize)> = recs
+        .iter()
+        .filter_map(|r| match r {
+            Rec::Decision(t, e, _) => Some((*t, *e)),
+            _ => None,
+        })
+        .collect();
+    assert!(decisions.len() >= 3, "{decisions:?}");
+    assert!(decisions.iter().all(|&(_, e)| EXITS[e].2), "{decisions:?}");
+    // Segment 0 starts at tick 0 and reaches its last frame (19) at tick 19: decided at 28.
+    assert_eq!(decisions[0], (28, 1));
+    // Ticks 19..=28 all show frame 19 of segment 0 (channel 0 = segment * 100 + frame).
+    for r in &recs {
+        if let Rec::Pose(t, p) = r {
+            if (19..=28).contains(t) {
+                assert_eq!(p[0], 19.0, "tick {t}");
+            }
+        }
+    }
+    // Each later decision comes 9 ticks after its segment's last frame was first shown.
+    for w in decisions.windows(2) {
+        let seg = EXITS[w[1].1].0;
+        let len = [20u64, 12, 30][seg];
+        assert_eq!(w[1].0, w[0].0 + len + 9, "{w:?}");
+    }
+    // Deciding at once: the first decision is the interruption exit at tick 9.
+    let now = run_timed(
+        &vec![0i16; 16_000 * 4],
+        500,
+        false,
+        DecisionTiming::IMMEDIATE,
+    );
+    let first = now.iter().find_map(|r| match r {
+        Rec::Decision(t, e, _) => Some((*t, *e)),
+        _ => None,
+    });
+    assert_eq!(first, Some((9, 0)));
+}
+
+#[test]
+fn with_speech_every_decision_follows_an_onset_or_the_longest_wait() {
+    let audio = speech(8.0);
+    let recs = run(&audio, 160);
+    let onsets: Vec<u64> = recs
+        .iter()
+        .filter_map(|r| match r {
+            Rec::Onset(t, _) => Some(*t),
+            _ => None,
+        })
+        .collect();
+    assert!(onsets.len() >= 15, "{} onsets", onsets.len());
+    let pose_at = |tick: u64| {
+        recs.iter().find_map(|r| match r {
+            Rec::Pose(t, p) if *t == tick => Some(p[0]),
+            _ => None,
+        })
+    };
+    let (mut fresh, mut waited) = (0, 0);
+    for r in &recs {
+        let Rec::Decision(t, e, _) = *r else {
+            continue;
+        };
+        // Fresh: an onset arrived for this tick or the one before (within 50 ms at 30 fps).
+        if onsets.iter().any(|&o| o <= t && t - o <= 1) {
+            fresh += 1;
+            continue;
+        }
+        // Otherwise only a segment end decides, after showing its last frame for 10 ticks.
+        let (seg, frame, end) = EXITS[e];
+        assert!(
+            end,
+            "interruption exit {e} decided at tick {t} without an onset"
+        );
+        let last = (seg * 100 + frame) as f32;
+        assert!((t - 9..=t).all(|k| pose_at(k) == Some(last)), "tick {t}");
+        waited += 1;
+    }
+    assert!(fresh > 0, "no decision on an onset");
+    eprintln!("{fresh} decisions on onsets, {waited} after the longest wait");
 }

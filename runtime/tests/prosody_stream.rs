@@ -291,3 +291,52 @@ fn speech_like_input_gives_syllables_at_a_speech_rate() {
         assert!(s.length_s() >= 0.06 && s.length_s() < 1.0, "{s:?}");
     }
 }
+
+#[test]
+fn every_syllable_start_is_reported_as_an_onset_before_the_syllable() {
+    let audio = speechlike_for_onsets();
+    let mut fe = FrontEnd::new(&ProsodyConfig::DEFAULT).unwrap();
+    let mut events = Vec::new();
+    fe.push(&audio, &mut |e| events.push(e));
+    fe.finish(&mut |e| events.push(e));
+    let mut syllables = 0;
+    for (i, e) in events.iter().enumerate() {
+        if let Event::Step(s) = e {
+            if s.kind == StepKind::Syllable {
+                syllables += 1;
+                assert!(
+                    events[..i]
+                        .iter()
+                        .any(|o| *o == Event::Onset(s.start_frame)),
+                    "syllable at frame {} has no onset before it",
+                    s.start_frame
+                );
+            }
+        }
+    }
+    assert!(syllables >= 8, "{syllables} syllables");
+    // Onsets come in frame order, each after the frame it starts at was reported.
+    let mut last = 0;
+    for (i, e) in events.iter().enumerate() {
+        if let Event::Onset(k) = e {
+            assert!(*k >= last);
+            last = *k;
+            assert!(events[..i]
+                .iter()
+                .any(|f| matches!(f, Event::Frame(fr) if fr.index == *k)));
+        }
+    }
+}
+
+/// Four bursts of 3 Hz syllables separated by silence.
+fn speechlike_for_onsets() -> Vec<i16> {
+    let rate = 16_000.0f32;
+    (0..(4.0 * rate) as usize)
+        .map(|i| {
+            let t = i as f32 / rate;
+            let env = (2.0 * std::f32::consts::PI * 3.0 * t).sin().max(0.0)
+                * if t % 1.0 < 0.75 { 1.0 } else { 0.0 };
+            (env * 8000.0 * (2.0 * std::f32::consts::PI * 140.0 * t).sin()) as i16
+        })
+        .collect()
+}

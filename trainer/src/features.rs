@@ -22,6 +22,7 @@ pub fn prosody_of(
     let mut sink = |ev: Event| match ev {
         Event::Frame(f) => frames.push(f),
         Event::Step(s) => steps.push(s),
+        Event::Onset(_) => {}
     };
     fe.push(samples, &mut sink);
     fe.finish(&mut sink);

@@ -258,6 +258,7 @@ pub fn run(
             probe.event_begin(&ev);
             match ev {
                 ControllerEvent::Frame(_) => sum.frames += 1,
+                ControllerEvent::Onset(_) => {}
                 ControllerEvent::Step { belief, .. } => {
                     sum.steps += 1;
                     sum.belief_hash = fnv(sum.belief_hash, belief);
@@ -280,7 +281,7 @@ pub fn run(
                         failure = Some(RunError::Output);
                     }
                 }
-                ControllerEvent::Pose { tick, pose } => {
+                ControllerEvent::Pose { tick, pose, .. } => {
                     sum.ticks += 1;
                     sum.pose_hash = fnv(sum.pose_hash, pose);
                     let _ = rig.apply(pose, dt_s);

@@ -222,7 +222,7 @@ impl Probe for Timing<'_> {
                 self.policy += since;
                 self.worst_decision = self.worst_decision.max(since);
             }
-            ControllerEvent::Pose { .. } => {}
+            ControllerEvent::Pose { .. } | ControllerEvent::Onset(_) => {}
         }
         self.last_event = t;
     }

@@ -242,5 +242,6 @@ fn record(
             sim.poses.push(pose.to_vec());
             sim.duties.push(rig.apply(pose));
         }
+        ControllerEvent::Onset(_) => {}
     }
 }

@@ -5,7 +5,7 @@
 //!  i16 samples ─┬─► 1 ms block sums ──────────────► intensity (dB, Praat's Kaiser window)
 //!               └─► half-band ÷2 ─► 40 ms Hann ─► autocorrelation ─► candidates
 //!                                                     ─► fixed-lag path finder ─► F0
-//!  per frame (F0, dB) ─► SyllableDetector ─► Step { syllable | pause }
+//!  per frame (F0, dB) ─► SyllableDetector ─► Step { syllable | pause }, Onset
 //! ```
 //!
 //! **Timing.** Frame `k` (k = 1, 2, ...) is centred at `k * 10 ms` after the first sample; the
@@ -187,6 +187,10 @@ pub enum Event {
     Frame(Frame),
     /// A finished syllable or pause step (reported after the frame that completed it).
     Step(Step),
+    /// A syllable onset was detected (reported after the frame that revealed it, and after the
+    /// step it closed, if any): the frame where the new syllable starts. See
+    /// [`SyllableDetector::take_onset`](syllable::SyllableDetector::take_onset).
+    Onset(u32),
 }
 
 fn finite_nonneg(v: f32) -> bool {
@@ -422,6 +426,9 @@ impl FrontEnd {
         }));
         if let Some(step) = self.syllables.push(index, f0_hz, db) {
             sink(Event::Step(step));
+        }
+        if let Some(frame) = self.syllables.take_onset() {
+            sink(Event::Onset(frame));
         }
     }
 

@@ -162,6 +162,8 @@ pub struct SyllableDetector {
     b: Acc,
     silent_run: u32,
     pause: Acc,
+    /// Start frame of a syllable that began at the last pushed frame, until taken.
+    onset: Option<u32>,
 }
 
 impl SyllableDetector {
@@ -181,6 +183,7 @@ impl SyllableDetector {
             b: Acc::default(),
             silent_run: 0,
             pause: Acc::default(),
+            onset: None,
         }
     }
 
@@ -199,8 +202,17 @@ impl SyllableDetector {
         }
     }
 
+    /// The start frame of a syllable onset detected by the last [`push`](Self::push), once:
+    /// speech rising out of silence (the frame itself), or a confirmed trough that begins a new
+    /// syllable (the trough's frame, which is the new syllable's `start_frame`). An onset out
+    /// of silence is reported as soon as it is seen, before the syllable proves prominent.
+    pub fn take_onset(&mut self) -> Option<u32> {
+        self.onset.take()
+    }
+
     /// Feeds frame `k` (consecutive). At most one step completes per frame.
     pub fn push(&mut self, k: u32, f0: Option<f32>, db: f32) -> Option<Step> {
+        self.onset = None;
         let db = if db.is_finite() { db } else { -300.0 };
         // Running peak: jumps up, decays 0.01 dB per frame.
         let decayed = self.peak_db - 0.01;
@@ -228,6 +240,7 @@ impl SyllableDetector {
             Phase::Silence => {
                 self.phase = Phase::Rising;
                 self.seg_start = k;
+                self.onset = Some(k);
                 // Speech rises out of silence: the opening "trough" is the silence threshold,
                 // so a syllable that starts abruptly at its plateau still counts.
                 self.start_level = self.threshold_db();
@@ -283,6 +296,7 @@ impl SyllableDetector {
                         .a
                         .step(StepKind::Syllable, self.seg_start, self.min_frame);
                     self.seg_start = self.min_frame;
+                    self.onset = Some(self.min_frame);
                     self.start_level = self.min_db;
                     self.a = self.b;
                     self.b = Acc::default();
