@@ -305,9 +305,7 @@ fn every_syllable_start_is_reported_as_an_onset_before_the_syllable() {
             if s.kind == StepKind::Syllable {
                 syllables += 1;
                 assert!(
-                    events[..i]
-                        .iter()
-                        .any(|o| *o == Event::Onset(s.start_frame)),
+                    events[..i].contains(&Event::Onset(s.start_frame)),
                     "syllable at frame {} has no onset before it",
                     s.start_frame
                 );
