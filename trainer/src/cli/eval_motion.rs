@@ -8,16 +8,18 @@ use gesture_runtime::prosody::{ProsodyConfig, StepKind};
 use serde::Serialize;
 
 use super::fit::parse_span;
-use super::{CliError, CorpusArgs};
-use crate::control::build::{build, ControlParams};
+use super::{CliError, ControlArgs, CorpusArgs};
+use crate::control::build::{build, QuantizedPolicy};
 use crate::control::quality::{
-    cut_frames, metrics, play_dp, play_online, play_random, positions, Metrics,
+    cut_frames, metrics, play_device, play_dp, play_random, positions, Metrics,
 };
 use crate::control::Library;
 use crate::corpus::discover;
 use crate::inference::model::InferenceModel;
+use crate::inference::quantize::QuantizedInference;
 use crate::inference::train::prosody_point;
 use crate::motion::{analyze, read_bvh, SegmentParams};
+use gesture_runtime::controller::DecisionTiming;
 
 /// Arguments of `eval-motion`.
 #[derive(Debug, clap::Args)]
@@ -46,6 +48,13 @@ pub struct EvalMotionArgs {
     /// Corpus loading options (effectors).
     #[command(flatten)]
     pub load: CorpusArgs,
+    /// Control-layer options.
+    #[command(flatten)]
+    pub control: ControlArgs,
+    /// Decide at every exit point at once instead of on syllable onsets (the runtime's
+    /// `DecisionTiming::IMMEDIATE`).
+    #[arg(long)]
+    pub immediate: bool,
 }
 
 /// One method's row.
@@ -88,7 +97,8 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
         &SegmentParams::default(),
         3,
     )?;
-    let cm = build(&model, &lib, &ControlParams::default());
+    a.control.validate()?;
+    let cm = build(&model, &lib, &a.control.params());
     let pcm = crate::audio::load_wav_at(&a.audio, model.sample_rate_hz)?;
     let rate = model.sample_rate_hz as f64;
     let (s0, s1) = a.span.unwrap_or((0.0, f64::INFINITY));
@@ -105,7 +115,6 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
         .iter()
         .map(|s| model.gmm.memberships(&prosody_point(&norm.push(s))))
         .collect();
-    let online = model.crf.beliefs(&m);
     let offline = if m.is_empty() {
         vec![]
     } else {
@@ -114,14 +123,6 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
     let fps = lib.fps;
     let frames = ((samples.len() as f64 / rate) * fps) as usize;
     let prior = model.state_prior.clone();
-    // Belief at frame t: after the last step that ended by then.
-    let belief = |t: usize| {
-        let time = t as f64 / fps;
-        match steps.iter().rposition(|s| s.end_s() <= time) {
-            Some(k) => online[k].clone(),
-            None => prior.clone(),
-        }
-    };
     let post = |t: usize| {
         let time = t as f64 / fps;
         match steps.iter().position(|s| s.end_s() > time) {
@@ -158,10 +159,31 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
             real_ref,
         )
     };
+    // The online controller is the device's: quantized tables through the runtime Controller
+    // (which starts at segment 0), so the references start there too.
     let start = 0;
+    let qp = QuantizedPolicy::new(&lib, &cm);
+    let qi = QuantizedInference::new(&model.gmm, &model.crf);
+    let timing = if a.immediate {
+        DecisionTiming::IMMEDIATE
+    } else {
+        DecisionTiming::DEFAULT
+    };
+    let online = play_device(
+        &lib,
+        &qp,
+        &qi.gmm,
+        qi.weights()
+            .ok_or("the quantized CRF tables are inconsistent")?,
+        &config,
+        timing,
+        samples,
+        frames,
+    )
+    .map_err(|e| e.to_string())?;
     let mut rows = vec![Row {
         method: "online".into(),
-        metrics: eval(&play_online(&lib, &cm.policy, frames, start, &belief)),
+        metrics: eval(&online),
     }];
     let random: Vec<Metrics> = (0..a.random_runs.max(1))
         .map(|seed| eval(&play_random(&lib, frames, start, seed)))

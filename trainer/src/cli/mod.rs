@@ -80,6 +80,47 @@ impl CorpusArgs {
     }
 }
 
+/// Control-layer options shared by `pack` and `eval-motion`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ControlArgs {
+    /// Weight of transition costs against the fit of a segment to the belief (lower: gestures
+    /// follow the speech more and the recorded order less, with more cuts).
+    #[arg(long, default_value_t = crate::control::costs::CostParams::default().transition_weight)]
+    pub transition_weight: f64,
+    /// Weight of the pose jump when a segment ends in a cut (not scaled by the transition
+    /// weight).
+    #[arg(long, default_value_t = crate::control::costs::CostParams::default().junction_weight)]
+    pub junction_weight: f64,
+    /// Added to the cost of leaving a segment at an interruption frame.
+    #[arg(long, default_value_t = crate::control::costs::CostParams::default().interruption_penalty)]
+    pub interruption_penalty: f64,
+}
+
+impl ControlArgs {
+    /// Control-layer settings from the arguments (everything else at its default).
+    pub fn params(&self) -> crate::control::build::ControlParams {
+        let mut p = crate::control::build::ControlParams::default();
+        p.cost.transition_weight = self.transition_weight;
+        p.cost.interruption_penalty = self.interruption_penalty;
+        p.cost.junction_weight = self.junction_weight;
+        p
+    }
+
+    /// Refuses values that make no sense.
+    pub fn validate(&self) -> Result<(), CliError> {
+        for (name, v) in [
+            ("--transition-weight", self.transition_weight),
+            ("--interruption-penalty", self.interruption_penalty),
+            ("--junction-weight", self.junction_weight),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} must be a finite number >= 0, not {v}").into());
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Model options shared by `fit` and `eval-inference`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelArgs {

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::{CliError, CorpusArgs};
+use super::{CliError, ControlArgs, CorpusArgs};
 use crate::pack::{pack, PackOptions};
 
 /// Arguments of `pack`.
@@ -32,11 +32,16 @@ pub struct PackArgs {
     /// Corpus loading options (effectors).
     #[command(flatten)]
     pub load: CorpusArgs,
+    /// Control-layer options.
+    #[command(flatten)]
+    pub control: ControlArgs,
 }
 
 /// Runs the command.
 pub fn run(a: &PackArgs) -> Result<(), CliError> {
+    a.control.validate()?;
     let opts = PackOptions {
+        control: a.control.params(),
         rig: a.rig.clone(),
         budget_bytes: a.budget_bytes,
         effectors: a.load.options().effectors,

@@ -3,6 +3,10 @@
 //! selection from the same library, the offline dynamic-programming sequence (posteriors that
 //! see the whole utterance), and, where the audio has its own motion capture, the real motion.
 //!
+//! The online sequence is what the device plays ([`play_device`]): the runtime's `Controller`
+//! over the quantized inference and the quantized, pruned policy, fed the audio's samples, with
+//! its decision timing (decisions on syllable onsets) and its detection latencies.
+//!
 //! Each method yields a frame-by-frame sequence of library frames at the library's rate; its
 //! effector positions are the library take's own positions for those frames (the motion the
 //! rig would show, before servo limits). Metrics:
@@ -18,6 +22,11 @@
 //!   sigma^2))` with `d` the distance to the nearest motion beat (local minimum of mean hand
 //!   speed), `sigma = 0.3 s`, averaged over onsets.
 
+use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
+use gesture_runtime::inference::{CrfWeights, GmmComponent};
+use gesture_runtime::player::LibraryFrames;
+use gesture_runtime::policy::{Choice, PolicyTables};
+use gesture_runtime::prosody::ProsodyConfig;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
@@ -252,7 +261,8 @@ pub fn metrics(
     Metrics {
         hellinger: real.map(|r| hellinger(&histogram(&sp), &histogram(&speeds(r, fps)))),
         mean_jerk: jerk.iter().sum::<f64>() / jerk.len().max(1) as f64,
-        jump_at_cuts: jumps.iter().sum::<f64>() / jumps.len().max(1) as f64,
+        // (+ 0.0: an empty f64 sum is -0.0)
+        jump_at_cuts: jumps.iter().sum::<f64>() / jumps.len().max(1) as f64 + 0.0,
         cuts_per_s: cuts.len() as f64 / (pos.len().max(1) as f64 / fps),
         beat_alignment: beat_alignment(onsets, &motion_beats(pos, fps), 0.3),
     }
@@ -267,17 +277,73 @@ pub fn cut_frames(seq: &[Played]) -> Vec<usize> {
         .collect()
 }
 
-/// Online play: at each exit, the policy's choice under the latest belief (`belief(t)`).
-pub fn play_online(
+/// Segment lengths of a library as the runtime player sees them (decisions do not depend on
+/// the poses, so no channels).
+struct Lengths<'a>(&'a Library);
+
+impl LibraryFrames for Lengths<'_> {
+    fn channels(&self) -> usize {
+        0
+    }
+    fn fps(&self) -> f32 {
+        self.0.fps as f32
+    }
+    fn segment_count(&self) -> usize {
+        self.0.segments.len()
+    }
+    fn segment_len(&self, c: usize) -> usize {
+        self.0.segments[c].len().max(1)
+    }
+    fn value(&self, _: usize, _: usize, _: usize) -> f32 {
+        0.0
+    }
+}
+
+/// Why the device could not be simulated.
+#[derive(Debug, thiserror::Error)]
+#[error("the controller could not be built: {0}")]
+pub struct DeviceError(String);
+
+/// Online play as the device does it: the runtime `Controller` (starting at segment 0) over
+/// the quantized `tables` and inference (`gmm`, `crf`), fed `samples`, with `timing`.
+/// Returns `frames` played frames (the last one held if the audio ends earlier).
+pub fn play_device<T: PolicyTables>(
     lib: &Library,
-    policy: &Policy,
+    tables: &T,
+    gmm: &[GmmComponent],
+    crf: CrfWeights<'_>,
+    config: &ProsodyConfig,
+    timing: DecisionTiming,
+    samples: &[i16],
     frames: usize,
-    start: usize,
-    belief: &dyn Fn(usize) -> Vec<f64>,
-) -> Vec<Played> {
-    play(lib, frames, start, |e, t| {
-        policy.decide(e, &belief(t), 0..lib.segments.len())
-    })
+) -> Result<Vec<Played>, DeviceError> {
+    let lengths = Lengths(lib);
+    let mut ctl = Controller::new(config, gmm, crf, tables, &lengths)
+        .map_err(|e| DeviceError(e.to_string()))?;
+    ctl.set_timing(timing);
+    let mut out: Vec<Played> = Vec::with_capacity(frames + 1);
+    let mut cut_next = false;
+    ctl.push(samples, &mut |ev| match ev {
+        ControllerEvent::Pose { segment, frame, .. } => {
+            out.push(Played {
+                segment,
+                frame,
+                cut: std::mem::take(&mut cut_next),
+            });
+        }
+        ControllerEvent::Decision { decision, .. } => {
+            if let Choice::Enter(c) = decision.choice {
+                let e = decision.exit;
+                cut_next = is_cut(lib, tables.exit_segment(e), c, tables.exit_is_end(e));
+            }
+        }
+        _ => {}
+    });
+    out.truncate(frames);
+    if let Some(&last) = out.last() {
+        out.resize(frames, Played { cut: false, ..last });
+    }
+    Ok(out)
 }
 
 /// Random selection: at end exits a uniformly random segment, otherwise continue.
