@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use gesture_runtime::controller::{Controller, ControllerEvent};
+use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::StepNormalizer;
 use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::Choice;
@@ -76,7 +76,13 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
     );
 
     let (mut agree, mut total) = (0usize, 0usize);
-    for wav in ["2_scott_0_1_1.wav", "2_scott_0_2_2.wav"] {
+    // Decisions on onsets (the default), and at every exit point (more decision points).
+    for (wav, timing) in [
+        ("2_scott_0_1_1.wav", DecisionTiming::DEFAULT),
+        ("2_scott_0_2_2.wav", DecisionTiming::DEFAULT),
+        ("2_scott_0_1_1.wav", DecisionTiming::IMMEDIATE),
+        ("2_scott_0_2_2.wav", DecisionTiming::IMMEDIATE),
+    ] {
         let pcm = gesture_trainer::audio::load_wav(d.join("beat-scott").join(wav)).unwrap();
         // Float beliefs after every step, from the trainer's float GMM and CRF.
         let (_, steps) =
@@ -96,6 +102,7 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
             &lengths,
         )
         .unwrap();
+        ctl.set_timing(timing);
         let mut decisions = Vec::new();
         let mut seen_steps = 0usize;
         ctl.push(&pcm.samples, &mut |e| match e {
@@ -125,7 +132,7 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
             }
         }
         eprintln!(
-            "{wav}: {} steps ({} syllables)",
+            "{wav} ({timing:?}): {} steps ({} syllables)",
             steps.len(),
             steps
                 .iter()
@@ -135,6 +142,101 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
     }
     let rate = agree as f64 / total as f64;
     eprintln!("decisions: {agree} of {total} agree ({:.2}%)", 100.0 * rate);
-    assert!(total > 150, "{total} decisions");
+    assert!(total > 300, "{total} decisions");
     assert!(rate >= 0.99, "agreement {rate}");
+}
+
+#[derive(clap::Parser)]
+struct FitCli {
+    #[command(flatten)]
+    args: gesture_trainer::cli::fit::FitArgs,
+}
+
+#[derive(clap::Parser)]
+struct EvalCli {
+    #[command(flatten)]
+    args: gesture_trainer::cli::eval_motion::EvalMotionArgs,
+}
+
+/// The pack issue's motion-quality requirement, with the command-line defaults: a model fitted
+/// on ZeroEGGS 0-40 s, the take's own library, the device's online controller (quantized,
+/// decisions on syllable onsets) against random selection from the same library, on held-out
+/// speech: ZeroEGGS 40-50 s and both beat-scott monologues (another speaker).
+#[test]
+fn online_controller_beats_random_on_jumps_and_beat_alignment_on_held_out_speech() {
+    use clap::Parser;
+    let Some(d) = data() else {
+        eprintln!("skipping: ../shared/data is absent, nothing measured");
+        return;
+    };
+    let ze = d.join("zeroeggs-067-speech2");
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model.json");
+    let fit = FitCli::parse_from([
+        "fit".as_ref(),
+        "--corpus".as_ref(),
+        ze.as_os_str(),
+        "--span".as_ref(),
+        "0:40".as_ref(),
+        "--out".as_ref(),
+        model.as_os_str(),
+    ]);
+    gesture_trainer::cli::fit::run(&fit.args).unwrap();
+    let wav = ze.join("067_Speech_2_first50s.wav");
+    let bvh = ze.join("067_Speech_2_first50s.bvh");
+    let scott = d.join("beat-scott");
+    let (s1, s2) = (
+        scott.join("2_scott_0_1_1.wav"),
+        scott.join("2_scott_0_2_2.wav"),
+    );
+    let cases: Vec<(Vec<&std::ffi::OsStr>, &str)> = vec![
+        (
+            vec![
+                "--audio".as_ref(),
+                wav.as_os_str(),
+                "--mocap".as_ref(),
+                bvh.as_os_str(),
+                "--span".as_ref(),
+                "40:50".as_ref(),
+            ],
+            "zeroeggs 40-50 s",
+        ),
+        (vec!["--audio".as_ref(), s1.as_os_str()], "2_scott_0_1_1"),
+        (vec!["--audio".as_ref(), s2.as_os_str()], "2_scott_0_2_2"),
+    ];
+    for (extra, name) in cases {
+        let mut argv: Vec<&std::ffi::OsStr> = vec![
+            "eval-motion".as_ref(),
+            "--model".as_ref(),
+            model.as_os_str(),
+            "--library".as_ref(),
+            ze.as_os_str(),
+        ];
+        argv.extend(extra);
+        let rows =
+            gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap();
+        let get = |m: &str| rows.iter().find(|r| r.method == m).unwrap().metrics;
+        let (online, random) = (get("online"), get("random"));
+        eprintln!(
+            "{name}: jump at cuts {:.2} vs random {:.2}; beat alignment {:.3} vs random {:.3}; \
+             cuts/s {:.2} vs {:.2}",
+            online.jump_at_cuts,
+            random.jump_at_cuts,
+            online.beat_alignment,
+            random.beat_alignment,
+            online.cuts_per_s,
+            random.cuts_per_s
+        );
+        // The online controller must make cuts (following the recorded order would win on
+        // jumps by never cutting), and make them smaller than random ones.
+        assert!(online.cuts_per_s > 0.1, "{name}: {online:?}");
+        assert!(
+            online.jump_at_cuts < random.jump_at_cuts,
+            "{name}: {online:?} vs {random:?}"
+        );
+        assert!(
+            online.beat_alignment > random.beat_alignment,
+            "{name}: {online:?} vs {random:?}"
+        );
+    }
 }
