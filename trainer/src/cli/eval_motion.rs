@@ -11,7 +11,7 @@ use super::fit::parse_span;
 use super::{CliError, ControlArgs, CorpusArgs};
 use crate::control::build::{build, QuantizedPolicy};
 use crate::control::quality::{
-    cut_frames, metrics, play_device, play_dp, play_random, positions, Metrics,
+    cut_frames, metrics, play_device, play_dp, play_random, positions, Device, Metrics,
 };
 use crate::control::Library;
 use crate::corpus::discover;
@@ -169,18 +169,16 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
     } else {
         DecisionTiming::DEFAULT
     };
-    let online = play_device(
-        &lib,
-        &qp,
-        &qi.gmm,
-        qi.weights()
+    let device = Device {
+        tables: &qp,
+        gmm: &qi.gmm,
+        crf: qi
+            .weights()
             .ok_or("the quantized CRF tables are inconsistent")?,
-        &config,
+        config,
         timing,
-        samples,
-        frames,
-    )
-    .map_err(|e| e.to_string())?;
+    };
+    let online = play_device(&lib, device, samples, frames).map_err(|e| e.to_string())?;
     let mut rows = vec![Row {
         method: "online".into(),
         metrics: eval(&online),

@@ -46,7 +46,6 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         budget_bytes: a.budget_bytes,
         effectors: a.load.options().effectors,
         no_skeleton: a.no_skeleton,
-        ..PackOptions::default()
     };
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
     outln!(

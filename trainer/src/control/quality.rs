@@ -304,19 +304,38 @@ impl LibraryFrames for Lengths<'_> {
 #[error("the controller could not be built: {0}")]
 pub struct DeviceError(String);
 
+/// What the device runs: the quantized policy `tables`, the quantized inference (`gmm`,
+/// `crf`), the front-end settings and the decision timing.
+pub struct Device<'a, T: PolicyTables> {
+    /// Policy tables.
+    pub tables: &'a T,
+    /// Prosody mixture.
+    pub gmm: &'a [GmmComponent],
+    /// CRF weights.
+    pub crf: CrfWeights<'a>,
+    /// Front-end settings.
+    pub config: ProsodyConfig,
+    /// When decisions happen.
+    pub timing: DecisionTiming,
+}
+
 /// Online play as the device does it: the runtime `Controller` (starting at segment 0) over
-/// the quantized `tables` and inference (`gmm`, `crf`), fed `samples`, with `timing`.
-/// Returns `frames` played frames (the last one held if the audio ends earlier).
+/// `device`, fed `samples`. Returns `frames` played frames (the last one held if the audio
+/// ends earlier).
 pub fn play_device<T: PolicyTables>(
     lib: &Library,
-    tables: &T,
-    gmm: &[GmmComponent],
-    crf: CrfWeights<'_>,
-    config: &ProsodyConfig,
-    timing: DecisionTiming,
+    device: Device<'_, T>,
     samples: &[i16],
     frames: usize,
 ) -> Result<Vec<Played>, DeviceError> {
+    let Device {
+        tables,
+        gmm,
+        crf,
+        config,
+        timing,
+    } = device;
+    let config = &config;
     let lengths = Lengths(lib);
     let mut ctl = Controller::new(config, gmm, crf, tables, &lengths)
         .map_err(|e| DeviceError(e.to_string()))?;
