@@ -330,16 +330,15 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
     }
 
     fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
-        let played = self.player.frame();
         let segment = self.player.segment();
-        self.player.tick(self.lib, &mut self.pose);
+        let played = self.player.tick(self.lib, &mut self.pose);
         let tick = self.ticks;
         self.ticks += 1;
         sink(ControllerEvent::Pose {
             tick,
             pose: &self.pose[..self.lib.channels().min(MAX_CHANNELS)],
             segment,
-            frame: played.min(self.lib.segment_len(segment).max(1) - 1),
+            frame: played,
         });
         let e = self.exit;
         if self.tables.exit_segment(e) == segment && played >= self.tables.exit_frame(e) {

@@ -66,8 +66,12 @@ impl Player {
     }
 
     /// Plays the current frame into `out[..channels]`, then advances one frame (holding the
-    /// last frame if the segment ends without a new decision).
-    pub fn tick<L: LibraryFrames + ?Sized>(&mut self, lib: &L, out: &mut [f32; MAX_CHANNELS]) {
+    /// last frame if the segment ends without a new decision). Returns the frame played.
+    pub fn tick<L: LibraryFrames + ?Sized>(
+        &mut self,
+        lib: &L,
+        out: &mut [f32; MAX_CHANNELS],
+    ) -> usize {
         let n = lib.channels().min(MAX_CHANNELS);
         let len = lib.segment_len(self.segment).max(1);
         let f = self.frame.min(len - 1);
@@ -90,6 +94,7 @@ impl Player {
         if self.frame + 1 < len {
             self.frame += 1;
         }
+        f
     }
 }
 

@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::StepNormalizer;
-use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::{ProsodyConfig, StepKind};
 use gesture_trainer::control::build::{build, ControlParams, QuantizedPolicy};
+use gesture_trainer::control::quality::SegmentLengths;
 use gesture_trainer::control::{Action, Library};
 use gesture_trainer::corpus::{load_corpus, LoadOptions};
 use gesture_trainer::inference::quantize::QuantizedInference;
@@ -18,27 +18,6 @@ use gesture_trainer::motion::{EffectorSpec, SegmentParams};
 fn data() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
     d.join("beat-scott").is_dir().then_some(d)
-}
-
-/// Segment lengths only: decisions do not depend on the poses.
-struct Lengths(Vec<usize>, f32);
-
-impl LibraryFrames for Lengths {
-    fn channels(&self) -> usize {
-        0
-    }
-    fn fps(&self) -> f32 {
-        self.1
-    }
-    fn segment_count(&self) -> usize {
-        self.0.len()
-    }
-    fn segment_len(&self, c: usize) -> usize {
-        self.0[c]
-    }
-    fn value(&self, _: usize, _: usize, _: usize) -> f32 {
-        0.0
-    }
 }
 
 #[test]
@@ -63,10 +42,7 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
     let cm = build(&model, &lib, &ControlParams::default());
     let qp = QuantizedPolicy::new(&lib, &cm);
     let qi = QuantizedInference::new(&model.gmm, &model.crf);
-    let lengths = Lengths(
-        lib.segments.iter().map(|s| s.len()).collect(),
-        lib.fps as f32,
-    );
+    let lengths = SegmentLengths(&lib);
     let pruned = 1.0 - cm.entries_kept() as f64 / cm.entries_total() as f64;
     eprintln!(
         "library {} segments, {} exits; pruned {:.1}%",

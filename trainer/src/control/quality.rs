@@ -22,7 +22,7 @@
 //!   sigma^2))` with `d` the distance to the nearest motion beat (local minimum of mean hand
 //!   speed), `sigma = 0.3 s`, averaged over onsets.
 
-use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
+use gesture_runtime::controller::{Controller, ControllerError, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::{CrfWeights, GmmComponent};
 use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::{Choice, PolicyTables};
@@ -279,9 +279,9 @@ pub fn cut_frames(seq: &[Played]) -> Vec<usize> {
 
 /// Segment lengths of a library as the runtime player sees them (decisions do not depend on
 /// the poses, so no channels).
-struct Lengths<'a>(&'a Library);
+pub struct SegmentLengths<'a>(pub &'a Library);
 
-impl LibraryFrames for Lengths<'_> {
+impl LibraryFrames for SegmentLengths<'_> {
     fn channels(&self) -> usize {
         0
     }
@@ -298,11 +298,6 @@ impl LibraryFrames for Lengths<'_> {
         0.0
     }
 }
-
-/// Why the device could not be simulated.
-#[derive(Debug, thiserror::Error)]
-#[error("the controller could not be built: {0}")]
-pub struct DeviceError(String);
 
 /// What the device runs: the quantized policy `tables`, the quantized inference (`gmm`,
 /// `crf`), the front-end settings and the decision timing.
@@ -327,19 +322,11 @@ pub fn play_device<T: PolicyTables>(
     device: Device<'_, T>,
     samples: &[i16],
     frames: usize,
-) -> Result<Vec<Played>, DeviceError> {
-    let Device {
-        tables,
-        gmm,
-        crf,
-        config,
-        timing,
-    } = device;
-    let config = &config;
-    let lengths = Lengths(lib);
-    let mut ctl = Controller::new(config, gmm, crf, tables, &lengths)
-        .map_err(|e| DeviceError(e.to_string()))?;
-    ctl.set_timing(timing);
+) -> Result<Vec<Played>, ControllerError> {
+    let tables = device.tables;
+    let lengths = SegmentLengths(lib);
+    let mut ctl = Controller::new(&device.config, device.gmm, device.crf, tables, &lengths)?;
+    ctl.set_timing(device.timing);
     let mut out: Vec<Played> = Vec::with_capacity(frames + 1);
     let mut cut_next = false;
     ctl.push(samples, &mut |ev| match ev {
