@@ -19,7 +19,6 @@
 //!   [`live::AudioSource`] trait, with a fake source for tests.
 //! - [`demo`]: `gesture-sim demo`: synth, fit, pack, a new utterance and `run`, in one command.
 //! - [`servo`]: virtual PWM pins under the runtime's `ServoRig`.
-//! - [`skeleton`]: rig poses back on the library's skeleton (the blob's skeleton section).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
@@ -32,4 +31,3 @@ pub mod live;
 pub mod prosody_cmd;
 pub mod run;
 pub mod servo;
-pub mod skeleton;

@@ -9,23 +9,27 @@
 //! and converted to `i16` as the WAV path does (scale by 32768, round, clamp).
 //!
 //! **Real-time safety.** cpal calls its data callback on an audio thread: the callback only
-//! mixes to mono into a fresh buffer and `try_send`s it on a bounded channel (a full channel
-//! drops the block and counts it, rather than blocking the audio thread). Everything else (the
-//! resampler, the controller, printing) runs on the calling thread.
+//! mixes each frame to mono and pushes it into a preallocated lock-free single-producer
+//! single-consumer ring (`rtrb`, 2 s of audio); it never allocates, locks or blocks. A full
+//! ring drops the rest of the block and counts the dropped samples (an atomic), rather than
+//! blocking the audio thread. Everything else (the resampler, the controller, printing) runs
+//! on the calling thread, which drains the ring.
 //!
 //! **No device.** With no input device (as on a headless server), `live` and `devices` fail
 //! with one line naming what is missing and exit status 2. ALSA's own diagnostics (which it
 //! would print to stderr while probing cards) are captured and dropped on Linux.
 
 use std::io::Write;
-use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, TrySendError};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{Controller, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::StepKind;
+use gesture_runtime::rig::MAX_CHANNELS;
 use rubato::audioadapter_buffers::direct::SequentialSliceOfSlices;
 use rubato::{Async, FixedAsync, Resampler, SincInterpolationParameters, WindowFunction};
 
@@ -246,9 +250,12 @@ pub fn live_loop(
 ) -> Result<LiveStats, LiveError> {
     let config = blob.prosody_config();
     let rate = config.sample_rate_hz;
-    let gmm = blob.gmm();
-    let mut controller = Controller::new(&config, gmm.as_slice(), blob.crf_weights(), blob, blob)
+    let mut slot = Box::new(None);
+    let controller = BlobController::from_blob_in(&mut slot, blob)
         .map_err(|e| LiveError::Backend(format!("controller: {e}")))?;
+    let mut device: Device<'_, '_, NullPin, MAX_CHANNELS> =
+        Device::new(controller, [NullPin; MAX_CHANNELS])
+            .map_err(|e| LiveError::Backend(format!("device: {e}")))?;
     let mut resampler = StreamResampler::new(source.rate_hz(), rate)?;
     let fps = blob.fps() as f64;
     let limit = opts.seconds.map(|s| (s * rate as f64).round() as u64);
@@ -279,7 +286,11 @@ pub fn live_loop(
         }
         fed += pcm.len() as u64;
         let now = fed as f64 / rate as f64;
-        controller.push(&pcm, &mut |e| {
+        // Null pins cannot fail.
+        let _ = device.push(&pcm, &mut |e| {
+            let DeviceEvent::Controller(e) = e else {
+                return;
+            };
             let r = match e {
                 ControllerEvent::Step { step, belief } => {
                     stats.steps += 1;
@@ -339,7 +350,7 @@ pub fn live_loop(
             break;
         }
     }
-    controller.finish(&mut |_| {});
+    let _ = device.finish(&mut |_| {});
     if opts.redraw {
         writeln!(out)?;
     }
@@ -414,10 +425,11 @@ pub fn devices(out: &mut dyn Write) -> Result<(), LiveError> {
 /// A cpal input stream as an [`AudioSource`]. Keep it on the thread that opened it.
 pub struct CpalSource {
     _stream: cpal::Stream,
-    rx: Receiver<Vec<f32>>,
+    rx: rtrb::Consumer<f32>,
     rate_hz: u32,
     errors: Arc<Mutex<Option<String>>>,
-    dropped: Arc<Mutex<u64>>,
+    failed: Arc<AtomicBool>,
+    dropped: Arc<AtomicU64>,
 }
 
 impl CpalSource {
@@ -462,32 +474,37 @@ impl CpalSource {
             let config = supported.config();
             let channels = config.channels.max(1) as usize;
             let rate_hz = config.sample_rate;
-            let (tx, rx) = sync_channel::<Vec<f32>>(256);
+            // Two seconds of mono audio: the controller thread drains it every 200 ms.
+            let (tx, rx) = rtrb::RingBuffer::<f32>::new((2 * rate_hz as usize).max(4096));
             let errors = Arc::new(Mutex::new(None));
-            let dropped = Arc::new(Mutex::new(0u64));
-            let (e2, d2) = (errors.clone(), dropped.clone());
+            let failed = Arc::new(AtomicBool::new(false));
+            let dropped = Arc::new(AtomicU64::new(0));
+            let (e2, f2, d2) = (errors.clone(), failed.clone(), dropped.clone());
+            // Not on the data path: cpal reports stream errors from its own context.
             let on_error = move |e: cpal::Error| {
                 if let Ok(mut g) = e2.lock() {
                     g.get_or_insert(e.to_string());
                 }
+                f2.store(true, Ordering::Release);
             };
-            // Mixes a block to mono and hands it over without blocking the audio thread.
+            // Mixes a block to mono into the ring without allocating, locking or blocking.
             fn sender<T: Copy + Send + 'static>(
-                tx: std::sync::mpsc::SyncSender<Vec<f32>>,
-                dropped: Arc<Mutex<u64>>,
+                mut tx: rtrb::Producer<f32>,
+                dropped: Arc<AtomicU64>,
                 channels: usize,
-                conv: fn(T) -> f32,
+                to_f32: fn(T) -> f32,
             ) -> impl FnMut(&[T], &cpal::InputCallbackInfo) + Send + 'static {
-                move |data: &[T], _| {
-                    let inv = 1.0 / channels as f32;
-                    let mono: Vec<f32> = data
-                        .chunks(channels)
-                        .map(|f| f.iter().map(|&x| conv(x)).sum::<f32>() * inv)
-                        .collect();
-                    if let Err(TrySendError::Full(_)) = tx.try_send(mono) {
-                        if let Ok(mut g) = dropped.lock() {
-                            *g += 1;
+                move |data: &[T], _: &cpal::InputCallbackInfo| {
+                    let scale = 1.0 / channels as f32;
+                    let mut lost = 0u64;
+                    for frame in data.chunks(channels) {
+                        let mono = frame.iter().map(|&x| to_f32(x)).sum::<f32>() * scale;
+                        if tx.push(mono).is_err() {
+                            lost += 1;
                         }
+                    }
+                    if lost > 0 {
+                        dropped.fetch_add(lost, Ordering::Relaxed);
                     }
                 }
             }
@@ -530,14 +547,15 @@ impl CpalSource {
                 rx,
                 rate_hz,
                 errors,
+                failed,
                 dropped,
             })
         })
     }
 
-    /// Blocks dropped because the controller fell behind.
-    pub fn dropped_blocks(&self) -> u64 {
-        self.dropped.lock().map_or(0, |g| *g)
+    /// Samples dropped because the controller fell behind.
+    pub fn dropped_samples(&self) -> u64 {
+        self.dropped.load(Ordering::Relaxed)
     }
 }
 
@@ -547,19 +565,31 @@ impl AudioSource for CpalSource {
     }
 
     fn read(&mut self, out: &mut Vec<f32>, timeout: Duration) -> Result<bool, LiveError> {
-        if let Some(e) = self.errors.lock().ok().and_then(|mut g| g.take()) {
-            return Err(LiveError::Backend(e));
-        }
-        match self.rx.recv_timeout(timeout) {
-            Ok(block) => {
-                out.extend(block);
-                while let Ok(b) = self.rx.try_recv() {
-                    out.extend(b);
-                }
-                Ok(true)
+        let start = Instant::now();
+        loop {
+            if self.failed.load(Ordering::Acquire) {
+                let e = self.errors.lock().ok().and_then(|mut g| g.take());
+                return Err(LiveError::Backend(
+                    e.unwrap_or_else(|| "the input stream failed".into()),
+                ));
             }
-            Err(RecvTimeoutError::Timeout) => Ok(true),
-            Err(RecvTimeoutError::Disconnected) => Ok(false),
+            let n = self.rx.slots();
+            if n > 0 {
+                if let Ok(chunk) = self.rx.read_chunk(n) {
+                    let (a, b) = chunk.as_slices();
+                    out.extend_from_slice(a);
+                    out.extend_from_slice(b);
+                    chunk.commit_all();
+                }
+                return Ok(true);
+            }
+            if self.rx.is_abandoned() {
+                return Ok(false);
+            }
+            if start.elapsed() >= timeout {
+                return Ok(true);
+            }
+            std::thread::sleep(Duration::from_millis(5));
         }
     }
 }

@@ -364,7 +364,7 @@ fn full_skeleton_blob_rebuilds_the_library_frames() {
     let s = setup();
     let bytes = std::fs::read(&s.full).unwrap();
     let blob = Blob::parse(&bytes).unwrap();
-    let pose_sk = host_sim::skeleton::PoseSkeleton::from_blob(&blob.skeleton().unwrap()).unwrap();
+    let pose_sk = gesture_trainer::rig::PoseSkeleton::from_blob(&blob.skeleton().unwrap()).unwrap();
     let take = read_bvh(s.corpus.join("take_000.bvh")).unwrap();
     let mut pose = vec![0.0f32; blob.channels()];
     let wrap = |d: f64| (d + 180.0).rem_euclid(360.0) - 180.0;
@@ -400,7 +400,7 @@ fn puppet_channels_read_back_from_the_rebuilt_frames() {
     let s = setup();
     let bytes = std::fs::read(&s.puppet).unwrap();
     let blob = Blob::parse(&bytes).unwrap();
-    let pose_sk = host_sim::skeleton::PoseSkeleton::from_blob(&blob.skeleton().unwrap()).unwrap();
+    let pose_sk = gesture_trainer::rig::PoseSkeleton::from_blob(&blob.skeleton().unwrap()).unwrap();
     let rig = Rig::load(workspace().join("rigs/puppet-8ch.toml")).unwrap();
     let bound = rig.bind(pose_sk.skeleton(), "test").unwrap();
     let mut pose = vec![0.0f32; blob.channels()];

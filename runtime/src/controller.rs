@@ -26,6 +26,7 @@
 //! written where they stay, so construction needs only a few KiB of stack beyond the controller
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
+use crate::blob::Blob;
 use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
@@ -122,6 +123,42 @@ impl core::fmt::Display for ControllerError {
 
 impl core::error::Error for ControllerError {}
 
+/// A controller over a blob's tables: what every host tool and board runs.
+pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
+
+impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
+    /// The controller over a validated blob's tables, with the blob's front-end settings and
+    /// decision timing: the one way host tools and boards build a controller.
+    ///
+    /// The controller is about 15 KiB and is copied on the stack on its way out of here; a
+    /// board with little RAM builds it in place with [`from_blob_in`](Self::from_blob_in).
+    pub fn from_blob(blob: &'a Blob<'a>) -> Result<Self, ControllerError> {
+        let mut slot = None;
+        Self::from_blob_in(&mut slot, blob)?;
+        slot.ok_or(ControllerError::Dimensions)
+    }
+
+    /// [`from_blob`](Self::from_blob), built in place in `slot` (on the caller's stack or in
+    /// a `static`) without a temporary copy. On an error `slot` is `None`.
+    pub fn from_blob_in<'s>(
+        slot: &'s mut Option<Self>,
+        blob: &'a Blob<'a>,
+    ) -> Result<&'s mut Self, ControllerError> {
+        let gmm = blob.gmm();
+        let config = blob.prosody_config();
+        let me = Self::new_in(
+            slot,
+            &config,
+            gmm.as_slice(),
+            blob.crf_weights(),
+            blob,
+            blob,
+        )?;
+        me.timing = blob.timing();
+        Ok(me)
+    }
+}
+
 /// The whole on-device controller over validated tables `T` (policy) and `L` (library).
 pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     tables: &'a T,
@@ -148,10 +185,9 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
 }
 
 impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
-    /// A controller at the start of segment 0 with a uniform belief.
-    ///
-    /// The controller is about 15 KiB and is copied on the stack on its way out of here; a
-    /// board with little RAM builds it in place with [`new_in`](Self::new_in) instead.
+    /// A controller at the start of segment 0 with a uniform belief, over tables that need
+    /// not come from a blob (the runtime's tests build small ones by hand). Host tools and
+    /// boards use [`from_blob`](Self::from_blob).
     pub fn new(
         config: &ProsodyConfig,
         gmm: &[GmmComponent],
@@ -225,6 +261,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             Some(me) => Ok(me),
             None => Err(ControllerError::Dimensions),
         }
+    }
+
+    /// The policy tables the controller decides with (for a blob controller, the blob).
+    pub fn tables(&self) -> &'a T {
+        self.tables
     }
 
     /// The current belief (uniform before the first step).

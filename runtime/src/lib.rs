@@ -35,10 +35,15 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+#[cfg(feature = "encode")]
+extern crate alloc;
+
 pub mod blob;
 pub mod controller;
+pub mod device;
 pub mod inference;
 pub mod player;
 pub mod policy;
 pub mod prosody;
 pub mod rig;
+pub mod rotation;

@@ -262,6 +262,12 @@ impl<P: SetDutyCycle, const N: usize> ServoRig<P, N> {
     /// Checks `cals` and `period_us` (the PWM period in us, e.g. 20 000 for 50 Hz) and builds
     /// the rig. The pins are not written; the commanded angles start at neutral.
     pub fn new(pins: [P; N], cals: [ChannelCal; N], period_us: f32) -> Result<Self, RigError> {
+        Self::check(&cals, period_us)?;
+        Ok(Self::new_unchecked(pins, cals, period_us))
+    }
+
+    /// The checks of [`new`](Self::new).
+    pub(crate) fn check(cals: &[ChannelCal; N], period_us: f32) -> Result<(), RigError> {
         if N > MAX_CHANNELS {
             return Err(RigError::TooManyChannels);
         }
@@ -270,16 +276,22 @@ impl<P: SetDutyCycle, const N: usize> ServoRig<P, N> {
             cal.validate()
                 .map_err(|error| RigError::Calibration { channel, error })?;
         }
+        Ok(())
+    }
+
+    /// [`new`](Self::new) after [`check`](Self::check) passed.
+    #[inline(always)]
+    pub(crate) fn new_unchecked(pins: [P; N], cals: [ChannelCal; N], period_us: f32) -> Self {
         let mut angles = [0.0; N];
         for (a, c) in angles.iter_mut().zip(cals.iter()) {
             *a = c.neutral_deg;
         }
-        Ok(ServoRig {
+        ServoRig {
             pins,
             cals,
             period_us,
             angles,
-        })
+        }
     }
 
     /// Moves every channel toward its target in `pose_deg` (one angle per channel, degrees)

@@ -166,7 +166,13 @@ fn trace(blob: &Path, inputs: &[String]) -> Result<(), String> {
         let mut text = String::new();
         let result = drive::run(name, &blob_bytes, &audio, &mut text, &mut drive::NoProbe);
         print!("{text}");
-        result.map_err(|e| format!("input {name} ({file}, blob {}): {e}", blob.display()))?;
+        result.map_err(|e| {
+            format!(
+                "input {name} ({file}, blob {}): {e} ({})",
+                blob.display(),
+                e.name()
+            )
+        })?;
     }
     Ok(())
 }

@@ -1,19 +1,18 @@
-//! The control layer end to end: the runtime Controller (quantized inference and policy)
-//! against the trainer's float, unpruned policy on real audio from another speaker.
+//! The control layer end to end: the packed blob's bytes through the runtime's controller
+//! (quantized inference and policy) against the trainer's float, unpruned policy on real
+//! audio from another speaker.
 
 use std::path::PathBuf;
 
-use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
+use gesture_runtime::blob::Blob;
+use gesture_runtime::controller::{BlobController, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::StepNormalizer;
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::{ProsodyConfig, StepKind};
-use gesture_trainer::control::build::{build, ControlParams, QuantizedPolicy};
-use gesture_trainer::control::quality::SegmentLengths;
-use gesture_trainer::control::{Action, Library};
+use gesture_trainer::control::Action;
 use gesture_trainer::corpus::{load_corpus, LoadOptions};
-use gesture_trainer::inference::quantize::QuantizedInference;
 use gesture_trainer::inference::train::{fit, prosody_point, sequences, FitConfig};
-use gesture_trainer::motion::{EffectorSpec, SegmentParams};
+use gesture_trainer::pack::{pack_model, PackOptions};
 
 fn data() -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
@@ -31,18 +30,15 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
     let corpus = load_corpus(std::slice::from_ref(&ze), &LoadOptions::default()).unwrap();
     let (seqs, segs) = sequences(&corpus, None);
     let (model, _) = fit(&seqs, &segs, &FitConfig::default(), &|_| {}).unwrap();
-    let lib = Library::from_files(
-        &[ze.join("067_Speech_2_first50s.bvh")],
-        &model.normalization,
-        &EffectorSpec::default(),
-        &SegmentParams::default(),
-        3,
-    )
-    .unwrap();
-    let cm = build(&model, &lib, &ControlParams::default());
-    let qp = QuantizedPolicy::new(&lib, &cm);
-    let qi = QuantizedInference::new(&model.gmm, &model.crf);
-    let lengths = SegmentLengths(&lib);
+    let mut packed = Vec::new();
+    for timing in [DecisionTiming::DEFAULT, DecisionTiming::IMMEDIATE] {
+        let opts = PackOptions {
+            timing,
+            ..PackOptions::default()
+        };
+        packed.push(pack_model(&model, &[ze.join("067_Speech_2_first50s.bvh")], &opts).unwrap());
+    }
+    let (lib, cm) = (&packed[0].library, &packed[0].control);
     let pruned = 1.0 - cm.entries_kept() as f64 / cm.entries_total() as f64;
     eprintln!(
         "library {} segments, {} exits; pruned {:.1}%",
@@ -53,12 +49,14 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
 
     let (mut agree, mut total) = (0usize, 0usize);
     // Decisions on onsets (the default), and at every exit point (more decision points).
-    for (wav, timing) in [
-        ("2_scott_0_1_1.wav", DecisionTiming::DEFAULT),
-        ("2_scott_0_2_2.wav", DecisionTiming::DEFAULT),
-        ("2_scott_0_1_1.wav", DecisionTiming::IMMEDIATE),
-        ("2_scott_0_2_2.wav", DecisionTiming::IMMEDIATE),
+    for (wav, p) in [
+        ("2_scott_0_1_1.wav", &packed[0]),
+        ("2_scott_0_2_2.wav", &packed[0]),
+        ("2_scott_0_1_1.wav", &packed[1]),
+        ("2_scott_0_2_2.wav", &packed[1]),
     ] {
+        let blob = Blob::parse(&p.bytes).unwrap();
+        let timing = blob.timing();
         let pcm = gesture_trainer::audio::load_wav(d.join("beat-scott").join(wav)).unwrap();
         // Float beliefs after every step, from the trainer's float GMM and CRF.
         let (_, steps) =
@@ -69,16 +67,8 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
             .map(|s| model.gmm.memberships(&prosody_point(&norm.push(s))))
             .collect();
         let float_beliefs = model.crf.beliefs(&m);
-        // The device: quantized everything, through the runtime Controller.
-        let mut ctl = Controller::new(
-            &ProsodyConfig::DEFAULT,
-            &qi.gmm,
-            qi.weights().unwrap(),
-            &qp,
-            &lengths,
-        )
-        .unwrap();
-        ctl.set_timing(timing);
+        // The device: the blob's bytes, quantized everything, through the runtime controller.
+        let mut ctl = BlobController::from_blob(&blob).unwrap();
         let mut decisions = Vec::new();
         let mut seen_steps = 0usize;
         ctl.push(&pcm.samples, &mut |e| match e {

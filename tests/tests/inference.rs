@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use gesture_runtime::inference::{memberships, Belief, StepNormalizer, MAX_CLUSTERS};
 use gesture_trainer::corpus::{load_corpus, LoadOptions};
 use gesture_trainer::inference::model::InferenceModel;
-use gesture_trainer::inference::quantize::QuantizedInference;
+use gesture_trainer::inference::quantize::inference_section;
 use gesture_trainer::inference::train::{
     fit, memberships as float_memberships, sequences, FitConfig, Sequence,
 };
@@ -21,8 +21,9 @@ fn zeroeggs() -> Option<PathBuf> {
 /// Runs the runtime's fixed-memory path (normalizer is already applied in the features) and
 /// returns the L1 distance to the float beliefs at every step.
 fn l1_per_step(model: &InferenceModel, seq: &Sequence) -> Vec<f64> {
-    let q = QuantizedInference::new(&model.gmm, &model.crf);
-    let w = q.weights().expect("dimensions within capacities");
+    let q = inference_section(&model.gmm, &model.crf).expect("dimensions fit the blob");
+    let w = q.crf_weights().expect("dimensions within capacities");
+    let gmm = q.components();
     let float = model.crf.beliefs(&float_memberships(&model.gmm, seq));
     let mut belief = Belief::new();
     let mut m = [0.0f32; MAX_CLUSTERS];
@@ -30,7 +31,7 @@ fn l1_per_step(model: &InferenceModel, seq: &Sequence) -> Vec<f64> {
         .iter()
         .zip(&float)
         .map(|(f, fb)| {
-            memberships(&q.gmm, f, &mut m);
+            memberships(&gmm, f, &mut m);
             belief.step(&w, &m);
             belief
                 .probs(model.states())

@@ -20,13 +20,14 @@
 #![warn(missing_docs)]
 
 pub mod audio;
-pub mod blob;
 pub mod cli;
 pub mod control;
 pub mod corpus;
+pub mod evaluate;
 pub mod features;
 pub mod inference;
 pub mod motion;
+pub mod output;
 pub mod pack;
 pub mod rig;
 pub mod synth;

@@ -1,11 +1,18 @@
 //! `gesture-train`: thin entry point; see `gesture_trainer::cli`.
 
+use std::process::ExitCode;
+
 use clap::Parser;
 
-fn main() {
+fn main() -> ExitCode {
     let cli = gesture_trainer::cli::Cli::parse();
-    if let Err(e) = gesture_trainer::cli::run(cli) {
-        eprintln!("gesture-train: {e}");
-        std::process::exit(2);
+    match gesture_trainer::cli::run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            if !matches!(e, gesture_trainer::cli::CliError::BrokenPipe) {
+                eprintln!("gesture-train: {e}");
+            }
+            ExitCode::from(e.exit_code())
+        }
     }
 }

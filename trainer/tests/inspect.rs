@@ -4,7 +4,13 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use gesture_trainer::blob::{encode, write_blob, OwnedPayload};
+use gesture_runtime::blob::encode::OwnedPayload;
+
+fn write_blob(path: &Path, p: &OwnedPayload) -> usize {
+    let bytes = p.encode().unwrap();
+    std::fs::write(path, &bytes).unwrap();
+    bytes.len()
+}
 
 fn inspect(path: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_gesture-train"))
@@ -29,7 +35,7 @@ fn refused(path: &Path, want: &str) {
 fn summarizes_a_valid_blob() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("example.blob");
-    let n = write_blob(&path, &OwnedPayload::example().payload()).unwrap();
+    let n = write_blob(&path, &OwnedPayload::example());
     let out = inspect(&path);
     assert!(
         out.status.success(),
@@ -39,11 +45,13 @@ fn summarizes_a_valid_blob() {
     let text = String::from_utf8(out.stdout).unwrap();
     for want in [
         format!(
-            "blob: {n} bytes, format version 2, flags 0x0000, payload {} bytes",
+            "blob: {n} bytes, format version 3, flags 0x0000, payload {} bytes",
             n - 16
         ),
         "sections (bytes): front_end ".to_string(),
         "front_end: 16000 Hz, pitch 75-600 Hz".to_string(),
+        "control: decisions on syllable onsets (within 50 ms; a segment end waits up to 300 ms)"
+            .to_string(),
         "inference: 2 states, 1 clusters, window 1".to_string(),
         "policy: 2 segments, 3 exit points (2 end, 1 interruption), 4 successor entries \
          (1.33 per exit point), discount 0.9"
@@ -69,7 +77,7 @@ fn summarizes_a_valid_blob() {
 #[test]
 fn bad_blobs_give_one_typed_error_line() {
     let dir = tempfile::tempdir().unwrap();
-    let good = encode(&OwnedPayload::example().payload()).unwrap();
+    let good = OwnedPayload::example().encode().unwrap();
     let write = |name: &str, bytes: &[u8]| {
         let p = dir.path().join(name);
         std::fs::write(&p, bytes).unwrap();

@@ -6,10 +6,11 @@
 //!   other, as a DMA double buffer would; a full buffer the main loop has not taken yet counts
 //!   as an overrun (LED toggles).
 //! - **Servos out**: eight hobby servos on TIM3 CH1-4 (PA6, PA7, PB0, PB1) and TIM4 CH1-4 (PB6,
-//!   PB7, PB8, PB9) at the blob's PWM period, driven by the runtime's `rig::ServoRig` with the
-//!   blob's calibration (clamped, slew-limited, neutral on fault).
+//!   PB7, PB8, PB9) at the blob's PWM period, driven by the runtime's device loop
+//!   (`device::Device`: the blob's controller and its `ServoRig` with the blob's calibration;
+//!   clamped, slew-limited, neutral at power-up).
 //! - **Policy**: the blob is `include_bytes!`'d (see `build.rs`), validated once at boot; the
-//!   `Controller` is built in place on the stack (`Controller::new_in`).
+//!   controller is built in place on the stack (`BlobController::from_blob_in`).
 //!
 //! On a bad blob (refused, not 8 channels, not 16 kHz) the servos stay unpowered (no PWM) and
 //! the LED (PC13) blinks fast. Cost, measured on the same runtime under QEMU
@@ -25,8 +26,8 @@ use cortex_m::interrupt::Mutex;
 use cortex_m_rt::entry;
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{Controller, ControllerEvent};
-use gesture_runtime::rig::{ChannelCal, ServoRig};
+use gesture_runtime::controller::BlobController;
+use gesture_runtime::device::Device;
 use panic_halt as _;
 use stm32f4xx_hal::adc::config::{AdcConfig, Clock, SampleTime};
 use stm32f4xx_hal::adc::Adc;
@@ -178,13 +179,6 @@ fn main() -> ! {
     if config.sample_rate_hz != RATE_HZ || blob.channels() != CHANNELS {
         refuse(&mut led);
     }
-    let mut cals = [ChannelCal::HOBBY; CHANNELS];
-    for (ch, cal) in cals.iter_mut().enumerate() {
-        match blob.calibration(ch) {
-            Some(c) => *cal = c,
-            None => refuse(&mut led),
-        }
-    }
     let period_us = blob.period_us();
     let pwm_hz = (1_000_000.0 / period_us + 0.5) as u32;
 
@@ -203,25 +197,15 @@ fn main() -> ! {
         Servo::Tim4(d4.with(gpiob.pb9).erase()),
     ];
     pins.iter_mut().for_each(Servo::enable);
-    let Ok(mut rig) = ServoRig::new(pins, cals, period_us) else {
-        refuse(&mut led)
-    };
-    let _ = rig.neutral();
-
-    // The controller, in place on this stack frame (about 15 KiB).
-    let gmm = blob.gmm();
+    // The controller, in place on this stack frame (about 15 KiB), and the device: the
+    // controller with the servo rig (the blob's calibration), which drives them to neutral.
     let mut slot = None;
-    let Ok(controller) = Controller::new_in(
-        &mut slot,
-        &config,
-        gmm.as_slice(),
-        blob.crf_weights(),
-        &blob,
-        &blob,
-    ) else {
+    let Ok(controller) = BlobController::from_blob_in(&mut slot, &blob) else {
         refuse(&mut led)
     };
-    let dt_s = 1.0 / blob.fps();
+    let Ok(mut device) = Device::new(controller, pins) else {
+        refuse(&mut led)
+    };
 
     // Microphone: TIM2 at 16 kHz, one ADC conversion per update interrupt.
     // ADC clock 96 MHz / 4 = 24 MHz (at most 36 MHz): a conversion takes (28 + 12) / 24 MHz
@@ -250,11 +234,10 @@ fn main() -> ! {
             led.toggle();
         }
         match chunk {
-            Some(samples) => controller.push(&samples, &mut |ev| {
-                if let ControllerEvent::Pose { pose, .. } = ev {
-                    let _ = rig.apply(pose, dt_s);
-                }
-            }),
+            // Timer channels cannot fail; nothing else to do per event.
+            Some(samples) => {
+                let _ = device.push(&samples, &mut |_| {});
+            }
             None => cortex_m::asm::wfi(),
         }
     }

@@ -1,4 +1,4 @@
-//! Drives the runtime's `Controller` over 16 kHz PCM the way a microphone DMA would deliver
+//! Drives the runtime's device loop over 16 kHz PCM the way a microphone DMA would deliver
 //! it, and writes the decision trace.
 //!
 //! This file is shared, byte for byte, by the firmware (`src/main.rs`) and by the host
@@ -20,22 +20,22 @@
 //!
 //! ## Checks on the way
 //!
-//! Every pose must be finite; it is driven through the runtime's `ServoRig` (the blob's
-//! calibration, 16-bit recording pins) and every duty cycle must stay within the
-//! 500..=2500 us pulse range. A violation stops the run with [`RunError::Pose`].
+//! The runtime's device loop (`gesture_runtime::device::Device`) runs the blob: every pose
+//! must be finite, and every duty cycle its `ServoRig` writes (the blob's calibration, 16-bit
+//! recording pins) must stay within the 500..=2500 us pulse range. A violation stops the run
+//! with [`RunError::Pose`].
 //!
-//! `no_std`, no heap: the controller and the DMA buffer are on the caller's stack.
+//! `no_std`, no heap: the device and the DMA buffer are on the caller's stack.
 
 use core::convert::Infallible;
 use core::fmt::{self, Write};
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use gesture_runtime::blob::{Blob, BlobError};
-use gesture_runtime::controller::{Controller, ControllerError, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::device::{Device, DeviceError, DeviceEvent};
 use gesture_runtime::policy::Choice;
-use gesture_runtime::rig::{
-    duty_cycle, ChannelCal, RigError, ServoRig, PULSE_MAX_US, PULSE_MIN_US,
-};
+use gesture_runtime::rig::{duty_cycle, PULSE_MAX_US, PULSE_MIN_US};
 
 /// Samples per DMA buffer (16 ms at 16 kHz).
 pub const CHUNK: usize = 256;
@@ -44,8 +44,8 @@ pub const AUDIO_RATE_HZ: u32 = 16_000;
 /// Servo channels of the board (the puppet rig, `rigs/puppet-8ch.toml`).
 pub const CHANNELS: usize = 8;
 
-/// The controller over a blob's tables, as [`run`] builds it.
-pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
+/// The device loop over a blob, as [`run`] builds it.
+pub type BoardDevice<'c, 'a> = Device<'c, 'a, RecordingPin, CHANNELS>;
 
 /// Why a run stopped.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,10 +62,8 @@ pub enum RunError {
         /// The blob's channel count.
         found: usize,
     },
-    /// The controller refused the blob's tables.
-    Controller(ControllerError),
-    /// The servo rig refused the blob's calibration.
-    Rig(RigError),
+    /// The device refused the blob (tables, channels or calibration).
+    Device(DeviceError),
     /// The audio is not whole 16-bit samples.
     OddAudio {
         /// Its length in bytes.
@@ -80,6 +78,25 @@ pub enum RunError {
     Output,
 }
 
+impl RunError {
+    /// The error without formatting code: a firmware logs this instead of `Debug` or
+    /// `Display` (the blob's `Display` formats floats, about 15 KiB of code; derived `Debug`
+    /// of the nested errors about 7 KiB).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Blob(e) => e.name(),
+            Self::SampleRate { .. } => "SampleRate",
+            Self::Channels { .. } => "Channels",
+            Self::Device(DeviceError::Controller(_)) => "Controller",
+            Self::Device(DeviceError::TooManyChannels { .. }) => "TooManyChannels",
+            Self::Device(DeviceError::Rig(_)) => "Rig",
+            Self::OddAudio { .. } => "OddAudio",
+            Self::Pose { .. } => "Pose",
+            Self::Output => "Output",
+        }
+    }
+}
+
 impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -92,8 +109,7 @@ impl fmt::Display for RunError {
                 f,
                 "blob drives {found} channels, this board has {CHANNELS} servos"
             ),
-            Self::Controller(e) => write!(f, "controller: {e}"),
-            Self::Rig(e) => write!(f, "servo rig: {e}"),
+            Self::Device(e) => write!(f, "device: {e}"),
             Self::OddAudio { len } => write!(f, "audio is {len} bytes, not whole i16 samples"),
             Self::Pose { tick } => write!(f, "invalid pose or servo pulse at tick {tick}"),
             Self::Output => f.write_str("writing the trace failed"),
@@ -145,7 +161,7 @@ pub struct Summary {
 
 /// A servo output that keeps the last duty cycle (a 16-bit timer channel).
 #[derive(Clone, Copy, Debug, Default)]
-struct RecordingPin {
+pub struct RecordingPin {
     duty: u16,
 }
 
@@ -182,17 +198,8 @@ fn fnv(mut h: u32, values: &[f32]) -> u32 {
 fn build<'s, 'a>(
     slot: &'s mut Option<BlobController<'a>>,
     blob: &'a Blob<'a>,
-) -> Result<&'s mut BlobController<'a>, ControllerError> {
-    let gmm = blob.gmm();
-    let config = blob.prosody_config();
-    Controller::new_in(
-        slot,
-        &config,
-        gmm.as_slice(),
-        blob.crf_weights(),
-        blob,
-        blob,
-    )
+) -> Result<&'s mut BlobController<'a>, DeviceError> {
+    BlobController::from_blob_in(slot, blob).map_err(DeviceError::Controller)
 }
 
 /// Runs a fresh controller from `blob` over `audio` (little-endian i16 at 16 kHz) in
@@ -219,23 +226,14 @@ pub fn run(
     if audio.len() % 2 != 0 {
         return Err(RunError::OddAudio { len: audio.len() });
     }
-    let mut cals = [ChannelCal::HOBBY; CHANNELS];
-    for (ch, cal) in cals.iter_mut().enumerate() {
-        // Validated with the blob: every channel has a calibration.
-        *cal = blob.calibration(ch).ok_or(RunError::Channels {
-            found: blob.channels(),
-        })?;
-    }
     let period_us = blob.period_us();
-    let mut rig = ServoRig::new([RecordingPin::default(); CHANNELS], cals, period_us)
-        .map_err(RunError::Rig)?;
-    let _ = rig.neutral();
     let duty_min = duty_cycle(PULSE_MIN_US, period_us, u16::MAX);
     let duty_max = duty_cycle(PULSE_MAX_US, period_us, u16::MAX);
-    let dt_s = 1.0 / blob.fps();
 
     let mut slot = None;
-    let controller = build(&mut slot, &blob).map_err(RunError::Controller)?;
+    let controller = build(&mut slot, &blob).map_err(RunError::Device)?;
+    let mut device: BoardDevice<'_, '_> =
+        Device::new(controller, [RecordingPin::default(); CHANNELS]).map_err(RunError::Device)?;
     probe.ready();
 
     writeln!(out, "input {name} samples={}", audio.len() / 2).map_err(|_| RunError::Output)?;
@@ -254,7 +252,23 @@ pub fn run(
             *s = i16::from_le_bytes([b[0], b[1]]);
         }
         probe.chunk_begin();
-        controller.push(&dma[..n], &mut |ev| {
+        // Recording pins cannot fail.
+        let _ = device.push(&dma[..n], &mut |dev| {
+            let ev = match dev {
+                DeviceEvent::Controller(ev) => ev,
+                DeviceEvent::Servos { tick, rig } => {
+                    let mut ok = true;
+                    for pin in rig.pins() {
+                        ok &= (duty_min..=duty_max).contains(&pin.duty);
+                        sum.duty_range.0 = sum.duty_range.0.min(pin.duty);
+                        sum.duty_range.1 = sum.duty_range.1.max(pin.duty);
+                    }
+                    if !ok && failure.is_none() {
+                        failure = Some(RunError::Pose { tick });
+                    }
+                    return;
+                }
+            };
             probe.event_begin(&ev);
             match ev {
                 ControllerEvent::Frame(_) => sum.frames += 1,
@@ -284,14 +298,7 @@ pub fn run(
                 ControllerEvent::Pose { tick, pose, .. } => {
                     sum.ticks += 1;
                     sum.pose_hash = fnv(sum.pose_hash, pose);
-                    let _ = rig.apply(pose, dt_s);
-                    let mut ok = pose.iter().all(|v| v.is_finite());
-                    for pin in rig.pins() {
-                        ok &= (duty_min..=duty_max).contains(&pin.duty);
-                        sum.duty_range.0 = sum.duty_range.0.min(pin.duty);
-                        sum.duty_range.1 = sum.duty_range.1.max(pin.duty);
-                    }
-                    if !ok && failure.is_none() {
+                    if !pose.iter().all(|v| v.is_finite()) && failure.is_none() {
                         failure = Some(RunError::Pose { tick });
                     }
                 }

@@ -177,9 +177,9 @@ fn main() -> ! {
         };
         run_stack = run_stack.max(peak_stack_bytes());
         if let Err(e) = result {
-            // Debug, not Display: the blob error's Display formats an f32 limit, which would
-            // link about 15 KiB of float formatting into the firmware.
-            let _ = writeln!(err, "error: input {name}: {e:?}");
+            // The variant's name, not Display or Debug: formatting the nested errors would
+            // link kilobytes of formatting code into the firmware.
+            let _ = writeln!(err, "error: input {name}: {}", e.name());
             ok = false;
             break;
         }
@@ -191,9 +191,10 @@ fn main() -> ! {
     let _ = writeln!(
         err,
         "memory peak_stack_bytes={} build_stack_bytes={build_stack} run_stack_bytes={run_stack} \
-         controller_bytes={} blob_bytes={}",
+         device_bytes={} blob_bytes={}",
         build_stack.max(run_stack),
-        core::mem::size_of::<drive::BlobController<'static>>(),
+        core::mem::size_of::<drive::BoardDevice<'static, 'static>>()
+            + core::mem::size_of::<gesture_runtime::controller::BlobController<'static>>(),
         BLOB.len()
     );
     exit(ok)

@@ -13,7 +13,7 @@
 //! to a temporary file and renamed, so a file is either complete or absent, and on a write
 //! failure no output file is left):
 //!
-//! - `motion.bvh`: the played poses on the library's skeleton ([`crate::skeleton`]), one frame
+//! - `motion.bvh`: the played poses on the library's skeleton ([`gesture_trainer::rig::PoseSkeleton`]), one frame
 //!   per animation tick at the library's frame rate (needs the blob's skeleton section);
 //! - `timeline.json`: steps, beliefs, decisions and detection latencies ([`timeline`]);
 //! - `servo.csv`: `tick,time_s,<channel>...`, the duty cycle of every channel at every tick,
@@ -39,7 +39,7 @@ use gesture_trainer::audio::{load_wav_at, AudioError};
 use gesture_trainer::motion::write_bvh;
 use gesture_trainer::rig::{Rig, RigError};
 
-use crate::skeleton::PoseSkeleton;
+use gesture_trainer::rig::PoseSkeleton;
 use sim::{median_max, simulate, SimOptions, Simulation};
 
 /// What `run` was asked to do.

@@ -27,7 +27,7 @@ use gesture_trainer::motion::fk::{all_targets, target_positions, Target};
 use gesture_trainer::motion::Motion;
 
 use super::sim::Simulation;
-use crate::skeleton::PoseSkeleton;
+use gesture_trainer::rig::PoseSkeleton;
 
 /// Most frames in the GIF.
 pub const GIF_MAX_FRAMES: usize = 300;

@@ -1,5 +1,6 @@
-//! The simulation itself: PCM at the blob's rate through the runtime's `Controller` in fixed
-//! chunks, every event recorded, every pose sent through the virtual servo rig.
+//! The simulation itself: PCM at the blob's rate through the runtime's device loop
+//! (`gesture_runtime::device::Device`: the controller and the `ServoRig` on virtual pins) in
+//! fixed chunks, every event and every duty cycle recorded.
 //!
 //! **Timing.** Samples arrive in chunks of `chunk` samples (10 ms by default), as a board's
 //! audio DMA would deliver them. A chunk is processed when its last sample has arrived, so a
@@ -14,12 +15,13 @@
 use std::time::{Duration, Instant};
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{Controller, ControllerError, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::device::{Device, DeviceEvent};
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::StepKind;
-use gesture_runtime::rig::ChannelCal;
+use gesture_runtime::rig::{ChannelCal, MAX_CHANNELS};
 
-use crate::servo::VirtualRig;
+use crate::servo::VirtualPin;
 
 /// One prosody frame (10 ms).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,8 +152,9 @@ pub struct SimOptions {
     pub realtime: bool,
 }
 
-/// Runs `samples` (at the blob's rate) through the controller of `blob`, with servo
-/// calibrations `cals` and PWM period `period_us` for the virtual rig.
+/// Runs `samples` (at the blob's rate) through the device loop of `blob` (the runtime's
+/// [`Device`]: its controller and its servo rig on virtual pins), with servo calibrations
+/// `cals` and PWM period `period_us`.
 pub fn simulate(
     blob: &Blob<'_>,
     samples: &[i16],
@@ -159,20 +162,22 @@ pub fn simulate(
     period_us: f32,
     opts: SimOptions,
 ) -> Result<Simulation, String> {
-    let config = blob.prosody_config();
-    let gmm = blob.gmm();
-    let mut controller = Controller::new(&config, gmm.as_slice(), blob.crf_weights(), blob, blob)
-        .map_err(|e: ControllerError| e.to_string())?;
-    let fps = blob.fps() as f64;
-    let mut rig =
-        VirtualRig::new(cals, period_us, (1.0 / fps) as f32).map_err(|e| e.to_string())?;
-    let rate = config.sample_rate_hz;
+    let mut slot = Box::new(None);
+    let controller = BlobController::from_blob_in(&mut slot, blob).map_err(|e| e.to_string())?;
+    let mut device: Device<'_, '_, VirtualPin, MAX_CHANNELS> = Device::calibrated(
+        controller,
+        [VirtualPin::default(); MAX_CHANNELS],
+        Some((cals, period_us)),
+    )
+    .map_err(|e| e.to_string())?;
+    let rate = blob.prosody_config().sample_rate_hz;
     let mut sim = Simulation {
         sample_rate_hz: rate,
-        fps,
+        fps: blob.fps() as f64,
         duration_s: samples.len() as f64 / rate as f64,
         ..Simulation::default()
     };
+    let channels = blob.channels();
     let start = Instant::now();
     let mut pushed = 0usize;
     for chunk in samples.chunks(opts.chunk.max(1)) {
@@ -184,27 +189,40 @@ pub fn simulate(
                 std::thread::sleep(wait);
             }
         }
-        controller.push(chunk, &mut |e| {
-            record(&mut sim, &mut rig, blob, now_s, false, e)
+        // Virtual pins cannot fail.
+        let _ = device.push(chunk, &mut |e| {
+            record(&mut sim, blob, channels, now_s, false, e)
         });
     }
     let now_s = pushed as f64 / rate as f64;
-    controller.finish(&mut |e| record(&mut sim, &mut rig, blob, now_s, true, e));
+    let _ = device.finish(&mut |e| record(&mut sim, blob, channels, now_s, true, e));
     sim.wall_s = start.elapsed().as_secs_f64();
     Ok(sim)
 }
 
-/// Records one controller event (`now_s`: the sample clock at the end of the current chunk;
+/// Records one device event (`now_s`: the sample clock at the end of the current chunk;
 /// `flushed`: reported by the end of the stream).
 fn record(
     sim: &mut Simulation,
-    rig: &mut VirtualRig,
     blob: &Blob<'_>,
+    channels: usize,
     now_s: f64,
     flushed: bool,
-    e: ControllerEvent<'_>,
+    e: DeviceEvent<'_, VirtualPin, MAX_CHANNELS>,
 ) {
     let fps = sim.fps;
+    let e = match e {
+        DeviceEvent::Servos { rig, .. } => {
+            sim.duties.push(
+                rig.pins()[..channels]
+                    .iter()
+                    .map(VirtualPin::duty)
+                    .collect(),
+            );
+            return;
+        }
+        DeviceEvent::Controller(e) => e,
+    };
     match e {
         ControllerEvent::Frame(f) => sim.frames.push(FrameRecord {
             time_s: f.time_s(),
@@ -238,10 +256,7 @@ fn record(
                 cost: decision.cost,
             })
         }
-        ControllerEvent::Pose { pose, .. } => {
-            sim.poses.push(pose.to_vec());
-            sim.duties.push(rig.apply(pose));
-        }
+        ControllerEvent::Pose { pose, .. } => sim.poses.push(pose.to_vec()),
         ControllerEvent::Onset(_) => {}
     }
 }

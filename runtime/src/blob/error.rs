@@ -15,6 +15,8 @@ pub enum Section {
     Inference,
     /// Value tables and successors.
     Policy,
+    /// Controller settings.
+    Control,
     /// Gesture segments and frames.
     Library,
     /// Output channels.
@@ -30,6 +32,7 @@ impl Section {
             Self::FrontEnd => "front_end",
             Self::Inference => "inference",
             Self::Policy => "policy",
+            Self::Control => "control",
             Self::Library => "library",
             Self::Rig => "rig",
             Self::Skeleton => "skeleton",
@@ -74,6 +77,12 @@ pub enum Field {
     SuccOffsets,
     /// `policy.succ` (and `policy.succ_cost_scale`).
     Succ,
+    /// `control.sync_to_onsets`.
+    SyncToOnsets,
+    /// `control.onset_window_ms`.
+    OnsetWindow,
+    /// `control.max_wait_ms`.
+    MaxWait,
     /// `library.channels`.
     Channels,
     /// `library.frames`.
@@ -128,6 +137,9 @@ impl Field {
             Self::Exits => "policy.exits",
             Self::SuccOffsets => "policy.succ_offsets",
             Self::Succ => "policy.succ",
+            Self::SyncToOnsets => "control.sync_to_onsets",
+            Self::OnsetWindow => "control.onset_window_ms",
+            Self::MaxWait => "control.max_wait_ms",
             Self::Channels => "library.channels",
             Self::Frames => "library.frames",
             Self::SegStart => "library.seg_start",
@@ -362,6 +374,12 @@ pub enum BlobError {
         /// Exit index.
         exit: u32,
     },
+    // --- control ---
+    /// A controller setting is out of its documented range.
+    BadControl {
+        /// The setting.
+        field: Field,
+    },
     // --- skeleton ---
     /// More skeleton joints than [`MAX_JOINTS`](super::MAX_JOINTS).
     TooManyJoints {
@@ -398,9 +416,62 @@ pub enum BlobError {
     },
 }
 
+impl BlobError {
+    /// The variant's name (`"BadCrc"`, `"TableLength"`, ...): what a firmware can log without
+    /// pulling in formatting code.
+    pub const fn name(&self) -> &'static str {
+        match self {
+            Self::BlobTooShort { .. } => "BlobTooShort",
+            Self::BadMagic => "BadMagic",
+            Self::UnsupportedVersion { .. } => "UnsupportedVersion",
+            Self::UnsupportedFlags { .. } => "UnsupportedFlags",
+            Self::Truncated { .. } => "Truncated",
+            Self::TrailingBytes { .. } => "TrailingBytes",
+            Self::BadCrc { .. } => "BadCrc",
+            Self::Malformed { .. } => "Malformed",
+            Self::FrontEnd(_) => "FrontEnd",
+            Self::ZeroCount { .. } => "ZeroCount",
+            Self::StateCountTooLarge { .. } => "StateCountTooLarge",
+            Self::ClusterCountTooLarge { .. } => "ClusterCountTooLarge",
+            Self::WindowTooLarge { .. } => "WindowTooLarge",
+            Self::TooManySegments { .. } => "TooManySegments",
+            Self::TooManyExits { .. } => "TooManyExits",
+            Self::TooManyChannels { .. } => "TooManyChannels",
+            Self::TooManyFrames { .. } => "TooManyFrames",
+            Self::StateCountMismatch { .. } => "StateCountMismatch",
+            Self::SegmentCountMismatch { .. } => "SegmentCountMismatch",
+            Self::TableLength { .. } => "TableLength",
+            Self::NotFinite { .. } => "NotFinite",
+            Self::BadFrameRate => "BadFrameRate",
+            Self::EmptySegment { .. } => "EmptySegment",
+            Self::SegmentOutOfFrames { .. } => "SegmentOutOfFrames",
+            Self::StrokeOutOfRange { .. } => "StrokeOutOfRange",
+            Self::BadPwmPeriod => "BadPwmPeriod",
+            Self::BadCalibration { .. } => "BadCalibration",
+            Self::ChannelNameCount { .. } => "ChannelNameCount",
+            Self::BadDiscount => "BadDiscount",
+            Self::ExitSegmentOutOfRange { .. } => "ExitSegmentOutOfRange",
+            Self::ExitFrameOutOfRange { .. } => "ExitFrameOutOfRange",
+            Self::ExitsNotSorted { .. } => "ExitsNotSorted",
+            Self::MissingEndExit { .. } => "MissingEndExit",
+            Self::SuccessorOffsetsNotMonotone { .. } => "SuccessorOffsetsNotMonotone",
+            Self::SuccessorSegmentOutOfRange { .. } => "SuccessorSegmentOutOfRange",
+            Self::SuccessorsNotSorted { .. } => "SuccessorsNotSorted",
+            Self::NoSuccessors { .. } => "NoSuccessors",
+            Self::BadControl { .. } => "BadControl",
+            Self::TooManyJoints { .. } => "TooManyJoints",
+            Self::JointNameCount { .. } => "JointNameCount",
+            Self::BadParent { .. } => "BadParent",
+            Self::BadJointChannels { .. } => "BadJointChannels",
+            Self::BadEndSite { .. } => "BadEndSite",
+            Self::BadDrive { .. } => "BadDrive",
+        }
+    }
+}
+
 impl fmt::Display for BlobError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        use super::{FORMAT_VERSION, HEADER_LEN};
+        use super::header::{FORMAT_VERSION, HEADER_LEN};
         match *self {
             Self::BlobTooShort { len } => write!(
                 f,
@@ -556,6 +627,10 @@ impl fmt::Display for BlobError {
             Self::NoSuccessors { exit } => {
                 write!(f, "exit point {exit} ends its segment but has no successor")
             }
+            Self::BadControl { field } => write!(
+                f,
+                "{field} is out of range (see docs/blob-format.md; repack the blob)"
+            ),
             Self::TooManyJoints { found } => write!(
                 f,
                 "{found} skeleton joints, a blob holds at most {} (use a smaller skeleton)",

@@ -1,63 +1,71 @@
 //! The policy blob: one byte string holding everything the device needs (front-end settings,
-//! GMM and CRF, value tables and successors, gesture library frames, rig calibration), checked
-//! once at load.
+//! GMM and CRF, value tables and successors, controller settings, gesture library frames, rig
+//! calibration), checked once at load; and, with the `encode` feature, the writer.
 //!
 //! ```text
 //!  0      4        6      8            12     16
 //!  "GSTB" version  flags  payload_len  crc32  postcard payload (payload_len bytes)
-//!         u16 LE   u16 LE u32 LE       u32 LE front_end | inference | policy | library | rig
-//!                                                | skeleton (optional, host-side)
+//!         u16 LE   u16 LE u32 LE       u32 LE front_end | inference | policy | control
+//!                                                | library | rig | skeleton (optional)
 //! ```
 //!
 //! `docs/blob-format.md` is the normative description: field meanings and units, the postcard
-//! encoding, every validation rule and the error it gives, and the versioning policy.
+//! encoding, every validation rule and the error it gives, and the versioning policy. This
+//! module is the format's only implementation: the reader below and, behind the `encode`
+//! feature (host tools), the writer in [`encode`](mod@encode), side by side.
+//!
+//! - `header`: magic, version, flags, length, CRC ([`Header`]);
+//! - `payload`: the wire structs, one per section ([`Payload`]);
+//! - `records`: fixed-size records in the byte tables and their little-endian readers;
+//! - `quantize`: the one quantizer of every `i16` table ([`quantize_symmetric`],
+//!   [`quantize_range`]);
+//! - `validate`: every rule of the format, in the documented order;
+//! - `view`: the validated [`Blob`] and its accessors;
+//! - `tables`: the blob as the controller's [`PolicyTables`](crate::policy::PolicyTables) and
+//!   [`LibraryFrames`](crate::player::LibraryFrames);
+//! - `skeleton`: the host-side skeleton section ([`SkeletonView`], [`BvhChannel`] codes);
+//! - `error`: [`BlobError`], named by phase and field;
+//! - [`encode`](mod@encode) (feature `encode`): owned sections, table layout and the
+//!   serializer, checked against [`Blob::parse`].
 //!
 //! **Invariants.** [`Blob::parse`] is the only gate: it never panics and never allocates for
 //! any input bytes, and returns a [`BlobError`] naming the first rule broken. Once it returns
 //! `Ok`, every dimension is within the runtime's capacities, every table's length matches its
 //! dimensions, every index stored in the blob is in range and every scale is finite, so the
-//! accessors are infallible: they do no checks that can fail and never panic. Accessors that take
-//! an index return `None` (or `0.0` for scalar table lookups, like
-//! [`I16Table::get`]) when the *caller's* index is out of range.
+//! accessors are infallible: they do no checks that can fail and never panic.
 //!
 //! **Zero copy.** The payload's tables are borrowed `&[u8]` of little-endian values, read on
 //! access, so a blob can stay in flash; a [`Blob`] is a few hundred bytes of slices and
-//! dimensions. Parsing walks the payload once (CRC, decode, validation), O(size).
-//!
-//! Loading checks the front-end settings with [`ProsodyConfig::validate`] (no front-end is
-//! built), so it needs only a few hundred bytes of stack.
+//! dimensions. Parsing walks the payload once (CRC, decode, validation), O(size), and checks
+//! the front-end settings with [`ProsodyConfig::validate`](crate::prosody::ProsodyConfig)
+//! without building a front-end, so it needs only a few hundred bytes of stack.
 
 mod crc;
+#[cfg(feature = "encode")]
+pub mod encode;
 mod error;
+mod header;
 mod payload;
+mod quantize;
+mod records;
 mod skeleton;
 mod tables;
 mod validate;
-
-use core::num::NonZeroU8;
+mod view;
 
 pub use crc::{crc32, Crc32};
 pub use error::{BlobError, Field, Section};
+pub use header::{Header, FORMAT_VERSION, HEADER_LEN, MAGIC};
 pub use payload::{
-    FrontEndSection, I16Section, InferenceSection, LibrarySection, Payload, PolicySection,
-    RigSection, SkeletonSection, CALIBRATION_RECORD_BYTES, DRIVE_RECORD_BYTES,
+    ControlSection, FrontEndSection, I16Section, InferenceSection, LibrarySection, Payload,
+    PolicySection, RigSection, SkeletonSection, CALIBRATION_RECORD_BYTES, DRIVE_RECORD_BYTES,
     END_SITE_RECORD_BYTES, EXIT_RECORD_BYTES, FRAME_SCALE_RECORD_BYTES, GMM_RECORD_BYTES,
     NO_STROKE, ROOT_PARENT, SUCCESSOR_RECORD_BYTES,
 };
-pub use skeleton::{Drive, DriveMode, SkeletonView, EULER_ORDERS, MAX_JOINTS};
-
-use crate::inference::{CrfWeights, GmmComponent, I16Table, MAX_CLUSTERS};
-#[cfg(doc)]
-use crate::prosody::FrontEnd;
-use crate::prosody::ProsodyConfig;
-use crate::rig::ChannelCal;
-
-/// The first four bytes of every blob.
-pub const MAGIC: [u8; 4] = *b"GSTB";
-/// The format version this runtime reads and the trainer writes.
-pub const FORMAT_VERSION: u16 = 2;
-/// Header length in bytes.
-pub const HEADER_LEN: usize = 16;
+pub use quantize::{quantize_range, quantize_symmetric, Quantization, QUANT_MAX};
+pub use records::{calibration_from_record, calibration_record, gmm_from_record, gmm_record};
+pub use skeleton::{BvhChannel, Drive, DriveMode, SkeletonView, EULER_ORDERS, MAX_JOINTS};
+pub use view::{Blob, ExitPoint, GmmComponents, SectionSizes, SegmentInfo, Successor, Successors};
 
 /// Most library segments.
 pub const MAX_SEGMENTS: usize = 4096;
@@ -69,670 +77,7 @@ pub const MAX_CHANNELS: usize = crate::rig::MAX_CHANNELS;
 pub const MAX_FRAMES: usize = 1 << 20;
 /// Highest library frame rate (frames per second).
 pub const MAX_FPS: f32 = 1000.0;
-
-/// The fixed 16-byte header.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Header {
-    /// Format version ([`FORMAT_VERSION`]).
-    pub version: u16,
-    /// Flags (0: version 2 defines none).
-    pub flags: u16,
-    /// Payload length in bytes.
-    pub payload_len: u32,
-    /// CRC-32 of the payload.
-    pub crc: u32,
-}
-
-impl Header {
-    /// The current-version header for `payload`; `None` if it is 4 GiB or longer.
-    pub fn for_payload(payload: &[u8]) -> Option<Self> {
-        Some(Self {
-            version: FORMAT_VERSION,
-            flags: 0,
-            payload_len: u32::try_from(payload.len()).ok()?,
-            crc: crc32(payload),
-        })
-    }
-
-    /// The header's bytes.
-    pub fn to_bytes(&self) -> [u8; HEADER_LEN] {
-        let mut b = [0u8; HEADER_LEN];
-        b[0..4].copy_from_slice(&MAGIC);
-        b[4..6].copy_from_slice(&self.version.to_le_bytes());
-        b[6..8].copy_from_slice(&self.flags.to_le_bytes());
-        b[8..12].copy_from_slice(&self.payload_len.to_le_bytes());
-        b[12..16].copy_from_slice(&self.crc.to_le_bytes());
-        b
-    }
-
-    /// Checks the header of `bytes` (length, magic, version, flags, payload length, CRC) and
-    /// returns it with the payload bytes.
-    pub fn check(bytes: &[u8]) -> Result<(Self, &[u8]), BlobError> {
-        let (head, body) = match bytes.split_first_chunk::<HEADER_LEN>() {
-            Some(x) => x,
-            None => return Err(BlobError::BlobTooShort { len: bytes.len() }),
-        };
-        if head[0..4] != MAGIC {
-            return Err(BlobError::BadMagic);
-        }
-        let h = Self {
-            version: u16::from_le_bytes([head[4], head[5]]),
-            flags: u16::from_le_bytes([head[6], head[7]]),
-            payload_len: u32::from_le_bytes([head[8], head[9], head[10], head[11]]),
-            crc: u32::from_le_bytes([head[12], head[13], head[14], head[15]]),
-        };
-        if h.version != FORMAT_VERSION {
-            return Err(BlobError::UnsupportedVersion { found: h.version });
-        }
-        if h.flags != 0 {
-            return Err(BlobError::UnsupportedFlags { found: h.flags });
-        }
-        let declared = h.payload_len;
-        let available = body.len();
-        match usize::try_from(declared) {
-            Ok(n) if n == available => {}
-            Ok(n) if n < available => {
-                return Err(BlobError::TrailingBytes {
-                    declared,
-                    available,
-                })
-            }
-            _ => {
-                return Err(BlobError::Truncated {
-                    declared,
-                    available,
-                })
-            }
-        }
-        let computed = crc32(body);
-        if computed != h.crc {
-            return Err(BlobError::BadCrc {
-                stored: h.crc,
-                computed,
-            });
-        }
-        Ok((h, body))
-    }
-}
-
-/// Encoded size of each payload section in bytes (they add up to the payload length).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct SectionSizes {
-    /// `front_end`.
-    pub front_end: usize,
-    /// `inference`.
-    pub inference: usize,
-    /// `policy`.
-    pub policy: usize,
-    /// `library`.
-    pub library: usize,
-    /// `rig`.
-    pub rig: usize,
-    /// `skeleton` (1 byte when absent: postcard's `None`).
-    pub skeleton: usize,
-}
-
-/// An exit point: a frame of a segment where the policy may switch.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ExitPoint {
-    /// Segment index.
-    pub segment: u16,
-    /// Frame within the segment.
-    pub frame: u16,
-}
-
-/// One allowed successor of an exit point.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Successor {
-    /// Segment to enter.
-    pub segment: u16,
-    /// State-independent successor cost S(source, segment) (dequantized).
-    pub cost: f32,
-}
-
-/// The successors of one exit point, in stored order.
-#[derive(Clone, Debug)]
-pub struct Successors<'a> {
-    chunks: core::slice::ChunksExact<'a, u8>,
-    scale: f32,
-}
-
-impl Successors<'_> {
-    fn decode(&self, c: &[u8]) -> Option<Successor> {
-        match *c {
-            [a, b, c, d] => Some(Successor {
-                segment: u16::from_le_bytes([a, b]),
-                cost: i16::from_le_bytes([c, d]) as f32 * self.scale,
-            }),
-            _ => None,
-        }
-    }
-}
-
-impl Iterator for Successors<'_> {
-    type Item = Successor;
-
-    fn next(&mut self) -> Option<Successor> {
-        let c = self.chunks.next()?;
-        self.decode(c)
-    }
-
-    fn nth(&mut self, n: usize) -> Option<Successor> {
-        let c = self.chunks.nth(n)?;
-        self.decode(c)
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        self.chunks.size_hint()
-    }
-}
-
-impl ExactSizeIterator for Successors<'_> {}
-
-/// A library segment.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SegmentInfo {
-    /// Index of its first frame in the frame table.
-    pub start: u32,
-    /// Length in frames (>= 1).
-    pub len: u16,
-    /// Stroke frame within the segment, if it has one.
-    pub stroke: Option<u16>,
-    /// Semantic label, if it has one.
-    pub label: Option<NonZeroU8>,
-}
-
-/// Encodes a channel calibration as its 28-byte `rig.calibration` record (7 little-endian
-/// `f32` in [`ChannelCal`] field order).
-pub fn calibration_record(c: &ChannelCal) -> [u8; CALIBRATION_RECORD_BYTES] {
-    let v = [
-        c.neutral_deg,
-        c.min_deg,
-        c.max_deg,
-        c.direction,
-        c.pulse_neutral_us,
-        c.us_per_deg,
-        c.max_slew_deg_per_s,
-    ];
-    let mut b = [0u8; CALIBRATION_RECORD_BYTES];
-    for (c, x) in b.chunks_exact_mut(4).zip(v) {
-        c.copy_from_slice(&x.to_le_bytes());
-    }
-    b
-}
-
-/// Decodes a 28-byte calibration record.
-pub fn calibration_from_record(b: &[u8; CALIBRATION_RECORD_BYTES]) -> ChannelCal {
-    let v: [f32; 7] = f32s(b);
-    ChannelCal {
-        neutral_deg: v[0],
-        min_deg: v[1],
-        max_deg: v[2],
-        direction: v[3],
-        pulse_neutral_us: v[4],
-        us_per_deg: v[5],
-        max_slew_deg_per_s: v[6],
-    }
-}
-
-/// Encodes a [`GmmComponent`] as its 52-byte record (13 little-endian `f32` in field order).
-pub fn gmm_record(c: &GmmComponent) -> [u8; GMM_RECORD_BYTES] {
-    let v = [
-        c.log_voiced,
-        c.log_unvoiced,
-        c.mean[0],
-        c.mean[1],
-        c.inv_chol[0],
-        c.inv_chol[1],
-        c.inv_chol[2],
-        c.log_norm,
-        c.coef[0],
-        c.coef[1],
-        c.coef[2],
-        c.inv_sd,
-        c.log_norm_f0,
-    ];
-    let mut b = [0u8; GMM_RECORD_BYTES];
-    for (c, x) in b.chunks_exact_mut(4).zip(v) {
-        c.copy_from_slice(&x.to_le_bytes());
-    }
-    b
-}
-
-/// Decodes a 52-byte GMM record.
-pub fn gmm_from_record(b: &[u8; GMM_RECORD_BYTES]) -> GmmComponent {
-    let v: [f32; 13] = f32s(b);
-    GmmComponent {
-        log_voiced: v[0],
-        log_unvoiced: v[1],
-        mean: [v[2], v[3]],
-        inv_chol: [v[4], v[5], v[6]],
-        log_norm: v[7],
-        coef: [v[8], v[9], v[10]],
-        inv_sd: v[11],
-        log_norm_f0: v[12],
-    }
-}
-
-/// Little-endian `f32`s of `b` (`N` of them; missing ones are 0).
-fn f32s<const N: usize>(b: &[u8]) -> [f32; N] {
-    let mut v = [0.0f32; N];
-    for (x, c) in v.iter_mut().zip(b.chunks_exact(4)) {
-        if let &[p, q, r, s] = c {
-            *x = f32::from_le_bytes([p, q, r, s]);
-        }
-    }
-    v
-}
-
-/// Record `i` of `N` bytes in `b`, if it is there (never panics, whatever `i`).
-#[inline]
-fn record<const N: usize>(b: &[u8], i: usize) -> Option<&[u8; N]> {
-    let s = i.checked_mul(N)?;
-    b.get(s..s.checked_add(N)?)?.first_chunk::<N>()
-}
-
-#[inline]
-fn u16_at(b: &[u8], i: usize) -> Option<u16> {
-    record::<2>(b, i).map(|r| u16::from_le_bytes(*r))
-}
-
-#[inline]
-fn i16_at(b: &[u8], i: usize) -> Option<i16> {
-    record::<2>(b, i).map(|r| i16::from_le_bytes(*r))
-}
-
-#[inline]
-fn u32_at(b: &[u8], i: usize) -> Option<u32> {
-    record::<4>(b, i).map(|r| u32::from_le_bytes(*r))
-}
-
-#[inline]
-fn f32_at(b: &[u8], i: usize) -> Option<f32> {
-    record::<4>(b, i).map(|r| f32::from_le_bytes(*r))
-}
-
-/// The GMM components of a blob, as [`memberships`](crate::inference::memberships) takes them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GmmComponents {
-    comps: [GmmComponent; MAX_CLUSTERS],
-    len: usize,
-}
-
-impl GmmComponents {
-    /// The components.
-    pub fn as_slice(&self) -> &[GmmComponent] {
-        &self.comps[..self.len.min(MAX_CLUSTERS)]
-    }
-}
-
-/// A validated policy blob borrowing its bytes. See the module docs for the guarantees.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Blob<'a> {
-    header: Header,
-    sizes: SectionSizes,
-    payload: Payload<'a>,
-    crf: CrfWeights<'a>,
-    u: I16Table<'a>,
-    u_cont: I16Table<'a>,
-}
-
-impl<'a> Blob<'a> {
-    /// Checks `bytes` completely (header, CRC, decoding, every field) and returns the
-    /// validated blob, or the first rule broken. Never panics, never allocates.
-    pub fn parse(bytes: &'a [u8]) -> Result<Self, BlobError> {
-        let (header, body) = Header::check(bytes)?;
-        let (payload, sizes) = decode(body)?;
-        let v = validate::payload(&payload)?;
-        Ok(Self {
-            header,
-            sizes,
-            payload,
-            crf: v.crf,
-            u: v.u,
-            u_cont: v.u_cont,
-        })
-    }
-
-    // --- the whole blob ---
-
-    /// The header.
-    pub fn header(&self) -> Header {
-        self.header
-    }
-
-    /// Encoded size of each section.
-    pub fn section_sizes(&self) -> SectionSizes {
-        self.sizes
-    }
-
-    /// The decoded (and validated) sections, for tools that print or re-encode them.
-    pub fn payload(&self) -> &Payload<'a> {
-        &self.payload
-    }
-
-    // --- front_end ---
-
-    /// The front-end configuration (accepted by [`FrontEnd::new`]).
-    pub fn prosody_config(&self) -> ProsodyConfig {
-        self.payload.front_end.config()
-    }
-
-    // --- inference ---
-
-    /// Hidden states S (1..=[`MAX_STATES`](crate::inference::MAX_STATES)).
-    pub fn states(&self) -> usize {
-        self.payload.inference.states as usize
-    }
-
-    /// Prosody clusters K (1..=[`MAX_CLUSTERS`]).
-    pub fn clusters(&self) -> usize {
-        self.payload.inference.clusters as usize
-    }
-
-    /// CRF window W (1..=[`MAX_WINDOW`](crate::inference::MAX_WINDOW)).
-    pub fn window(&self) -> usize {
-        self.payload.inference.window as usize
-    }
-
-    /// GMM component `k` (`None` if `k >= clusters()`).
-    pub fn gmm_component(&self, k: usize) -> Option<GmmComponent> {
-        record::<GMM_RECORD_BYTES>(self.payload.inference.gmm, k).map(gmm_from_record)
-    }
-
-    /// All GMM components, decoded.
-    pub fn gmm(&self) -> GmmComponents {
-        let mut g = GmmComponents {
-            comps: [GmmComponent::default(); MAX_CLUSTERS],
-            len: self.clusters().min(MAX_CLUSTERS),
-        };
-        for (c, r) in g
-            .comps
-            .iter_mut()
-            .zip(self.payload.inference.gmm.chunks_exact(GMM_RECORD_BYTES))
-        {
-            if let Some(r) = r.first_chunk::<GMM_RECORD_BYTES>() {
-                *c = gmm_from_record(r);
-            }
-        }
-        g
-    }
-
-    /// The CRF weights.
-    pub fn crf_weights(&self) -> CrfWeights<'a> {
-        self.crf
-    }
-
-    // --- policy ---
-
-    /// Library segments (1..=[`MAX_SEGMENTS`]).
-    pub fn segments(&self) -> usize {
-        self.payload.policy.segments as usize
-    }
-
-    /// Exit points (1..=[`MAX_EXITS`]).
-    pub fn exit_points(&self) -> usize {
-        self.payload.policy.exit_points as usize
-    }
-
-    /// Successor entries over all exit points.
-    pub fn successor_entries(&self) -> usize {
-        self.payload.policy.succ.len() / SUCCESSOR_RECORD_BYTES
-    }
-
-    /// The value iteration's discount.
-    pub fn discount(&self) -> f32 {
-        self.payload.policy.discount
-    }
-
-    /// U(segment, state): cost-to-go of entering `segment` in `state` (0 out of range).
-    #[inline]
-    pub fn u(&self, segment: usize, state: usize) -> f32 {
-        if segment >= self.segments() || state >= self.states() {
-            return 0.0;
-        }
-        self.u.get(segment * self.states() + state)
-    }
-
-    /// U_cont(exit, state): cost-to-go of continuing past `exit` in `state` (0 out of range).
-    #[inline]
-    pub fn u_cont(&self, exit: usize, state: usize) -> f32 {
-        if exit >= self.exit_points() || state >= self.states() {
-            return 0.0;
-        }
-        // Bounded by the capacities, so the index arithmetic cannot overflow.
-        self.u_cont.get(exit * self.states() + state)
-    }
-
-    /// Exit point `e`.
-    pub fn exit(&self, e: usize) -> Option<ExitPoint> {
-        let r = record::<EXIT_RECORD_BYTES>(self.payload.policy.exits, e)?;
-        Some(ExitPoint {
-            segment: u16::from_le_bytes([r[0], r[1]]),
-            frame: u16::from_le_bytes([r[2], r[3]]),
-        })
-    }
-
-    /// Whether exit point `e` is at its segment's last frame (no continuing there).
-    pub fn exit_is_end(&self, e: usize) -> bool {
-        match self.exit(e) {
-            Some(x) => self
-                .segment(x.segment as usize)
-                .is_some_and(|s| x.frame == s.len - 1),
-            None => false,
-        }
-    }
-
-    /// The exit points of `segment`: a range of exit indices in frame order, never empty for a
-    /// segment in range (its last element is the segment's end exit). Binary search.
-    pub fn exits_of(&self, segment: usize) -> core::ops::Range<usize> {
-        let first = |seg: usize| {
-            let (mut lo, mut hi) = (0usize, self.exit_points());
-            while lo < hi {
-                let mid = lo + (hi - lo) / 2;
-                match self.exit(mid) {
-                    Some(e) if (e.segment as usize) < seg => lo = mid + 1,
-                    _ => hi = mid,
-                }
-            }
-            lo
-        };
-        first(segment)..first(segment.saturating_add(1))
-    }
-
-    /// The exit point at `frame` of `segment`, if there is one (binary search).
-    pub fn find_exit(&self, segment: u16, frame: u16) -> Option<usize> {
-        let key = (segment, frame);
-        let (mut lo, mut hi) = (0usize, self.exit_points());
-        while lo < hi {
-            let mid = lo + (hi - lo) / 2;
-            let e = self.exit(mid)?;
-            match (e.segment, e.frame).cmp(&key) {
-                core::cmp::Ordering::Less => lo = mid + 1,
-                core::cmp::Ordering::Greater => hi = mid,
-                core::cmp::Ordering::Equal => return Some(mid),
-            }
-        }
-        None
-    }
-
-    /// The allowed successors of exit point `exit` (empty if out of range).
-    pub fn successors(&self, exit: usize) -> Successors<'a> {
-        let p = &self.payload.policy;
-        let range = (|| {
-            let a = u32_at(p.succ_offsets, exit)? as usize;
-            let b = u32_at(p.succ_offsets, exit.checked_add(1)?)? as usize;
-            p.succ.get(
-                a.checked_mul(SUCCESSOR_RECORD_BYTES)?..b.checked_mul(SUCCESSOR_RECORD_BYTES)?,
-            )
-        })();
-        Successors {
-            chunks: range.unwrap_or(&[]).chunks_exact(SUCCESSOR_RECORD_BYTES),
-            scale: p.succ_cost_scale,
-        }
-    }
-
-    /// Number of successors of exit point `exit` (0 if out of range).
-    pub fn successor_count(&self, exit: usize) -> usize {
-        self.successors(exit).len()
-    }
-
-    /// The `k`-th successor of exit point `exit`, in stored (segment) order; O(1).
-    pub fn successor(&self, exit: usize, k: usize) -> Option<Successor> {
-        self.successors(exit).nth(k)
-    }
-
-    // --- library ---
-
-    /// Output channels (1..=[`MAX_CHANNELS`]).
-    pub fn channels(&self) -> usize {
-        self.payload.library.channels as usize
-    }
-
-    /// Library frame rate (frames per second).
-    pub fn fps(&self) -> f32 {
-        self.payload.library.fps
-    }
-
-    /// Frames in the frame table (1..=[`MAX_FRAMES`]).
-    pub fn frames(&self) -> usize {
-        self.payload.library.frames as usize
-    }
-
-    /// Segment `s`.
-    pub fn segment(&self, s: usize) -> Option<SegmentInfo> {
-        let l = &self.payload.library;
-        let stroke = u16_at(l.strokes, s)?;
-        Some(SegmentInfo {
-            start: u32_at(l.seg_start, s)?,
-            len: u16_at(l.seg_len, s)?,
-            stroke: (stroke != NO_STROKE).then_some(stroke),
-            label: NonZeroU8::new(*l.labels.get(s)?),
-        })
-    }
-
-    /// Value of channel `ch` at frame `f` of the frame table (degrees; 0 out of range).
-    #[inline]
-    pub fn frame(&self, ch: usize, f: usize) -> f32 {
-        let l = &self.payload.library;
-        let n = self.channels();
-        if ch >= n {
-            return 0.0;
-        }
-        let v = f
-            .checked_mul(n)
-            .and_then(|i| i.checked_add(ch))
-            .and_then(|i| i16_at(l.frame_values, i));
-        match (
-            v,
-            f32_at(l.frame_scales, 2 * ch),
-            f32_at(l.frame_scales, 2 * ch + 1),
-        ) {
-            (Some(v), Some(scale), Some(offset)) => offset + scale * v as f32,
-            _ => 0.0,
-        }
-    }
-
-    /// Value of channel `ch` at frame `f` of segment `seg` (degrees; 0 out of range).
-    #[inline]
-    pub fn segment_value(&self, seg: usize, f: usize, ch: usize) -> f32 {
-        match self.segment(seg) {
-            Some(s) if f < s.len as usize => self.frame(ch, s.start as usize + f),
-            _ => 0.0,
-        }
-    }
-
-    /// The pose at frame `f` of the frame table into `out` (as many channels as fit); returns
-    /// the number of channels written (0 if `f` is out of range).
-    pub fn pose(&self, f: usize, out: &mut [f32]) -> usize {
-        if f >= self.frames() {
-            return 0;
-        }
-        let n = self.channels().min(out.len());
-        for (ch, o) in out.iter_mut().enumerate().take(n) {
-            *o = self.frame(ch, f);
-        }
-        n
-    }
-
-    // --- rig ---
-
-    /// The rig's name.
-    pub fn rig_name(&self) -> &'a str {
-        self.payload.rig.name
-    }
-
-    /// PWM period (microseconds; accepted by [`ServoRig::new`](crate::rig::ServoRig::new)).
-    pub fn period_us(&self) -> f32 {
-        self.payload.rig.period_us
-    }
-
-    /// Calibration of channel `ch` (passes [`ChannelCal::validate`]).
-    pub fn calibration(&self, ch: usize) -> Option<ChannelCal> {
-        record::<CALIBRATION_RECORD_BYTES>(self.payload.rig.calibration, ch)
-            .map(calibration_from_record)
-    }
-
-    /// Name of channel `ch`.
-    pub fn channel_name(&self, ch: usize) -> Option<&'a str> {
-        self.channel_names().nth(ch)
-    }
-
-    /// Channel names in order (one per channel).
-    pub fn channel_names(&self) -> core::str::Split<'a, char> {
-        self.payload.rig.channel_names.split('\n')
-    }
-
-    // --- skeleton ---
-
-    /// The library's skeleton and the rig channels' drives, if the blob carries them (host
-    /// tools only; validated like every other section).
-    pub fn skeleton(&self) -> Option<SkeletonView<'a>> {
-        self.payload.skeleton.map(SkeletonView::new)
-    }
-}
-
-/// Decodes the sections one after the other, recording their encoded sizes. Postcard encodes a
-/// struct as the concatenation of its fields, so this is exactly `Payload`'s encoding.
-fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
-    fn take<'a, T: serde::Deserialize<'a>>(
-        rest: &mut &'a [u8],
-        section: Section,
-    ) -> Result<(T, usize), BlobError> {
-        let before = rest.len();
-        let (v, r) =
-            postcard::take_from_bytes::<T>(rest).map_err(|_| BlobError::Malformed { section })?;
-        *rest = r;
-        Ok((v, before - r.len()))
-    }
-    let mut rest = body;
-    let (front_end, fe) = take(&mut rest, Section::FrontEnd)?;
-    let (inference, inf) = take(&mut rest, Section::Inference)?;
-    let (policy, pol) = take(&mut rest, Section::Policy)?;
-    let (library, lib) = take(&mut rest, Section::Library)?;
-    let (rig, rg) = take(&mut rest, Section::Rig)?;
-    let (skeleton, sk) = take(&mut rest, Section::Skeleton)?;
-    if !rest.is_empty() {
-        return Err(BlobError::Malformed {
-            section: Section::Skeleton,
-        });
-    }
-    Ok((
-        Payload {
-            front_end,
-            inference,
-            policy,
-            library,
-            rig,
-            skeleton,
-        },
-        SectionSizes {
-            front_end: fe,
-            inference: inf,
-            policy: pol,
-            library: lib,
-            rig: rg,
-            skeleton: sk,
-        },
-    ))
-}
+/// Longest onset window of the `control` section (ms).
+pub const MAX_ONSET_WINDOW_MS: u16 = 1000;
+/// Longest wait for an onset at a segment's end in the `control` section (ms).
+pub const MAX_WAIT_MS: u16 = 5000;

@@ -31,7 +31,7 @@ pub const DRIVE_RECORD_BYTES: usize = 6;
 /// `skeleton.parents` value of a root joint.
 pub const ROOT_PARENT: u16 = 0xFFFF;
 
-/// The whole payload: the five device sections in this order, then the optional host-side
+/// The whole payload: the six device sections in this order, then the optional host-side
 /// skeleton.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Payload<'a> {
@@ -43,6 +43,8 @@ pub struct Payload<'a> {
     /// Value tables, exit points and successors.
     #[serde(borrow)]
     pub policy: PolicySection<'a>,
+    /// Controller settings (decision timing).
+    pub control: ControlSection,
     /// Gesture segments and their frames.
     #[serde(borrow)]
     pub library: LibrarySection<'a>,
@@ -195,6 +197,30 @@ pub struct PolicySection<'a> {
     pub succ: &'a [u8],
     /// Multiplier of the successor costs.
     pub succ_cost_scale: f32,
+}
+
+/// How the controller runs the policy: when it decides
+/// ([`DecisionTiming`](crate::controller::DecisionTiming)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ControlSection {
+    /// 1: decisions wait for syllable onsets; 0: every exit point decides at once.
+    pub sync_to_onsets: u8,
+    /// An onset detected this recently counts as "now" (ms, <= 1000).
+    pub onset_window_ms: u16,
+    /// Longest wait for an onset at a segment's end (ms, <= 5000).
+    pub max_wait_ms: u16,
+}
+
+impl ControlSection {
+    /// The section holding `t` (durations saturate at `u16::MAX`).
+    pub fn from_timing(t: &crate::controller::DecisionTiming) -> Self {
+        let ms = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
+        Self {
+            sync_to_onsets: t.sync_to_onsets as u8,
+            onset_window_ms: ms(t.onset_window_ms),
+            max_wait_ms: ms(t.max_wait_ms),
+        }
+    }
 }
 
 /// The gesture library as output-channel frames.

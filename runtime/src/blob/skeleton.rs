@@ -8,7 +8,81 @@
 //! lookups walk the joint list (O(J)): fine on the host, not meant for a control loop.
 
 use super::payload::{SkeletonSection, DRIVE_RECORD_BYTES, END_SITE_RECORD_BYTES, ROOT_PARENT};
-use super::{f32_at, record, u16_at};
+use super::records::{f32_at, record, u16_at};
+
+/// One degree of freedom of a BVH joint, as named in a `CHANNELS` line; its blob code
+/// (`skeleton.channel_codes`) is its position in [`BvhChannel::ALL`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BvhChannel {
+    /// Translation along X (skeleton units), code 0.
+    Xposition,
+    /// Translation along Y (skeleton units), code 1.
+    Yposition,
+    /// Translation along Z (skeleton units), code 2.
+    Zposition,
+    /// Rotation about X (degrees), code 3.
+    Xrotation,
+    /// Rotation about Y (degrees), code 4.
+    Yrotation,
+    /// Rotation about Z (degrees), code 5.
+    Zrotation,
+}
+
+impl BvhChannel {
+    /// All six channels, in code order: positions then rotations.
+    pub const ALL: [BvhChannel; 6] = [
+        Self::Xposition,
+        Self::Yposition,
+        Self::Zposition,
+        Self::Xrotation,
+        Self::Yrotation,
+        Self::Zrotation,
+    ];
+
+    /// The name used in BVH files (`Xposition`, ..., `Zrotation`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Xposition => "Xposition",
+            Self::Yposition => "Yposition",
+            Self::Zposition => "Zposition",
+            Self::Xrotation => "Xrotation",
+            Self::Yrotation => "Yrotation",
+            Self::Zrotation => "Zrotation",
+        }
+    }
+
+    /// Parses a channel name, ignoring letter case (`Zrotation`, `ZROTATION`, `zrotation`).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name().eq_ignore_ascii_case(name))
+    }
+
+    /// The blob code (0..=5).
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+
+    /// The channel of a blob code, `None` above 5.
+    pub fn from_code(code: u8) -> Option<Self> {
+        Self::ALL.get(code as usize).copied()
+    }
+
+    /// The axis: 0 for X, 1 for Y, 2 for Z.
+    pub fn axis(self) -> usize {
+        (self as usize) % 3
+    }
+
+    /// The rotation channel about `axis` (0..=2; larger counts as Z).
+    pub fn rotation(axis: usize) -> Self {
+        [Self::Xrotation, Self::Yrotation, Self::Zrotation][axis.min(2)]
+    }
+
+    /// True for the three rotation channels.
+    pub fn is_rotation(self) -> bool {
+        self as u8 >= 3
+    }
+}
 
 /// Most joints a skeleton section may have.
 pub const MAX_JOINTS: usize = 1024;
@@ -159,9 +233,12 @@ impl<'a> SkeletonView<'a> {
         start..start + counts[j] as usize
     }
 
-    /// Code of frame channel `i`: 0..=5 = `Xposition` .. `Zrotation` (`None` out of range).
-    pub fn channel_code(&self, i: usize) -> Option<u8> {
-        self.s.channel_codes.get(i).copied()
+    /// Frame channel `i` (`None` out of range).
+    pub fn channel(&self, i: usize) -> Option<BvhChannel> {
+        self.s
+            .channel_codes
+            .get(i)
+            .and_then(|&c| BvhChannel::from_code(c))
     }
 
     /// Rest-pose value of frame channel `i` (0 out of range).
@@ -197,5 +274,11 @@ impl<'a> SkeletonView<'a> {
     /// Number of drive records (the rig's channel count).
     pub fn drives(&self) -> usize {
         self.s.drives.len() / DRIVE_RECORD_BYTES
+    }
+}
+
+impl core::fmt::Display for BvhChannel {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
     }
 }

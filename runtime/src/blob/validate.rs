@@ -1,13 +1,16 @@
 //! Field validation of a decoded payload, in the order of docs/blob-format.md ("Validation"):
 //! front_end, inference, library, rig, policy (the policy indexes into the library, so the
-//! library is checked first), then the optional skeleton. Each check returns the first rule broken; O(payload size), no
-//! allocation, no panics (all index arithmetic is checked or bounded by the capacities).
+//! library is checked first), control, then the optional skeleton. Each check returns the
+//! first rule broken; O(payload size), no allocation, no panics (all index arithmetic is
+//! checked or bounded by the capacities).
 
 use super::error::{BlobError, Field};
 use super::payload::*;
+use super::records::{calibration_from_record, f32_at, record, u16_at, u32_at};
 use super::skeleton::{Drive, MAX_JOINTS};
-use super::{calibration_from_record, MAX_SEGMENTS};
-use super::{f32_at, record, u16_at, u32_at, MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES};
+use super::{
+    MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES, MAX_ONSET_WINDOW_MS, MAX_SEGMENTS, MAX_WAIT_MS,
+};
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
 use crate::rig::validate_period;
 
@@ -24,6 +27,7 @@ pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
     library(&p.library)?;
     rig(&p.rig, p.library.channels as usize)?;
     let (u, u_cont) = policy(&p.policy, &p.inference, &p.library)?;
+    control(&p.control)?;
     if let Some(sk) = &p.skeleton {
         skeleton(sk, p.library.channels as usize)?;
     }
@@ -341,6 +345,20 @@ fn policy<'a>(
         }
     }
     Ok((u, u_cont))
+}
+
+fn control(c: &ControlSection) -> Result<(), BlobError> {
+    let bad = |field| Err(BlobError::BadControl { field });
+    if c.sync_to_onsets > 1 {
+        return bad(Field::SyncToOnsets);
+    }
+    if c.onset_window_ms > MAX_ONSET_WINDOW_MS {
+        return bad(Field::OnsetWindow);
+    }
+    if c.max_wait_ms > MAX_WAIT_MS {
+        return bad(Field::MaxWait);
+    }
+    Ok(())
 }
 
 fn all_finite(bytes: &[u8]) -> bool {

@@ -98,6 +98,12 @@ pub struct I16Table<'a> {
 }
 
 impl<'a> I16Table<'a> {
+    /// The table with no values.
+    pub const EMPTY: I16Table<'static> = I16Table {
+        bytes: &[],
+        scale: 1.0,
+    };
+
     /// A table of `len` values; `None` if `bytes` does not hold exactly that many or the scale
     /// is not finite.
     pub fn new(bytes: &'a [u8], scale: f32, len: usize) -> Option<Self> {
@@ -146,6 +152,16 @@ pub struct CrfWeights<'a> {
 }
 
 impl<'a> CrfWeights<'a> {
+    /// No weights (0 states): the placeholder of an unconfigured controller.
+    pub const EMPTY: CrfWeights<'static> = CrfWeights {
+        states: 0,
+        clusters: 0,
+        window: 0,
+        init: I16Table::EMPTY,
+        trans: I16Table::EMPTY,
+        obs: I16Table::EMPTY,
+    };
+
     /// Checks dimensions against the capacities and the table lengths.
     pub fn new(
         states: usize,

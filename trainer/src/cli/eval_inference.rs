@@ -12,8 +12,8 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use super::fit::parse_span;
-use super::{CliError, CorpusArgs, ModelArgs};
+use super::args::{parse_span, CorpusArgs, ModelArgs};
+use super::CliError;
 use crate::corpus::load_corpus;
 use crate::inference::eval::{
     adjusted_rand_index, crf_beliefs, mean_score, prior_beliefs, RemappedHmm,
@@ -193,17 +193,17 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         struct Rows<'a> {
             rows: &'a [Row],
         }
-        outln!("{}", serde_json::to_string(&Rows { rows: &rows })?);
+        outln!("{}", serde_json::to_string(&Rows { rows: &rows })?)?;
         return Ok(());
     }
-    outln!("mean log-likelihood per test step of the true kinematic parameters");
+    outln!("mean log-likelihood per test step of the true kinematic parameters")?;
     outln!(
         "{:>6} {:>10} {:>10} {:>10}",
         "window",
         "crf",
         "hmm",
         "prior"
-    );
+    )?;
     for r in &rows {
         outln!(
             "{:>6} {:>10.3} {:>10.3} {:>10.3}",
@@ -211,8 +211,8 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
             r.crf,
             r.hmm,
             r.prior
-        );
+        )?;
     }
-    outln!("{extras}");
+    outln!("{extras}")?;
     Ok(())
 }

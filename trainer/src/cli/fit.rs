@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{CliError, CorpusArgs, ModelArgs};
+use super::args::{parse_span, CorpusArgs, ModelArgs};
+use super::CliError;
 use crate::corpus::load_corpus;
 use crate::inference::train::{fit, sequences};
 
@@ -30,27 +31,6 @@ pub struct FitArgs {
     pub load: CorpusArgs,
 }
 
-/// Parses `START:END` (seconds).
-pub fn parse_span(s: &str) -> Result<(f64, f64), String> {
-    let (a, b) = s
-        .split_once(':')
-        .ok_or("expected START:END in seconds, e.g. 0:40")?;
-    let a: f64 = if a.is_empty() {
-        0.0
-    } else {
-        a.parse().map_err(|_| format!("bad start `{a}`"))?
-    };
-    let b: f64 = if b.is_empty() {
-        f64::INFINITY
-    } else {
-        b.parse().map_err(|_| format!("bad end `{b}`"))?
-    };
-    if !(a >= 0.0 && b > a) {
-        return Err(format!("span {s}: need 0 <= START < END"));
-    }
-    Ok((a, b))
-}
-
 /// Runs the command.
 pub fn run(a: &FitArgs) -> Result<(), CliError> {
     let start = Instant::now();
@@ -75,6 +55,6 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         report.seconds[1],
         report.seconds[2],
         start.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }

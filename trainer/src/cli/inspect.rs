@@ -21,8 +21,7 @@ pub fn run(a: &InspectArgs) -> Result<(), CliError> {
     let name = a.blob.display();
     let bytes = std::fs::read(&a.blob).map_err(|e| format!("{name}: {e}"))?;
     let blob = Blob::parse(&bytes).map_err(|e| format!("{name}: {e}"))?;
-    print!("{}", summary(&blob));
-    Ok(())
+    outln!("{}", summary(&blob).trim_end())
 }
 
 /// The summary printed by `inspect`, one fact group per line.
@@ -39,8 +38,9 @@ pub fn summary(b: &Blob<'_>) -> String {
     );
     let _ = writeln!(
         s,
-        "sections (bytes): front_end {}, inference {}, policy {}, library {}, rig {}, skeleton {}",
-        z.front_end, z.inference, z.policy, z.library, z.rig, z.skeleton
+        "sections (bytes): front_end {}, inference {}, policy {}, control {}, library {}, rig {}, \
+         skeleton {}",
+        z.front_end, z.inference, z.policy, z.control, z.library, z.rig, z.skeleton
     );
     let c = b.prosody_config();
     let _ = writeln!(
@@ -51,6 +51,19 @@ pub fn summary(b: &Blob<'_>) -> String {
         c.pitch.ceiling_hz,
         c.syllables.margin_db,
         c.syllables.pause_frames
+    );
+    let t = b.timing();
+    let _ = writeln!(
+        s,
+        "control: decisions {}",
+        if t.sync_to_onsets {
+            format!(
+                "on syllable onsets (within {} ms; a segment end waits up to {} ms)",
+                t.onset_window_ms, t.max_wait_ms
+            )
+        } else {
+            "at every exit point at once".to_string()
+        }
     );
     let _ = writeln!(
         s,

@@ -1,22 +1,18 @@
-//! The `gesture-train` command line: argument parsing into validated settings and dispatch to
-//! the library. Every command prints what it did to stdout and progress to stderr; errors are
-//! one line, and the binary exits with status 2 on any error. Output goes through the `outln!`
-//! macro, which ends the process quietly (status 0) when stdout is a closed pipe
-//! (`gesture-train ... | head`) instead of panicking like `println!`.
+//! The `gesture-train` command line, and nothing else: each command's flags (clap) are
+//! checked into the library's settings ([`args`]), the library does the work, and the result
+//! is printed. Every command prints what it did to stdout and progress to stderr; an error is
+//! one line on stderr and an exit status ([`CliError::exit_code`]: 2 bad input, 1 failure).
+//! Output goes through `outln!`, which turns a closed stdout (`gesture-train ... | head`)
+//! into a quiet [`CliError::BrokenPipe`] instead of a panic.
 
-/// `println!` that exits with status 0 when stdout is a closed pipe.
+/// `println!` that returns a `Result` (see [`write_line`]).
 macro_rules! outln {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let mut out = std::io::stdout().lock();
-        if let Err(e) = writeln!(out, $($arg)*) {
-            if e.kind() == std::io::ErrorKind::BrokenPipe {
-                std::process::exit(0);
-            }
-        }
-    }};
+    ($($arg:tt)*) => {
+        $crate::cli::write_line(format_args!($($arg)*))
+    };
 }
 
+pub mod args;
 pub mod eval_inference;
 pub mod eval_motion;
 pub mod fit;
@@ -25,7 +21,7 @@ pub mod pack;
 mod stats;
 mod synth;
 
-use std::path::PathBuf;
+use std::path::Path;
 
 use clap::{Parser, Subcommand};
 
@@ -57,112 +53,125 @@ pub enum Command {
     Inspect(inspect::InspectArgs),
 }
 
-/// Options shared by commands that read a corpus.
-#[derive(Debug, Clone, clap::Args)]
-pub struct CorpusArgs {
-    /// End-effector joints (default: the two hands, found by common names).
-    #[arg(long, value_delimiter = ',')]
-    pub effectors: Vec<String>,
-    /// Largest accepted difference between audio and motion length, in seconds.
-    #[arg(long, default_value_t = 0.5)]
-    pub max_mismatch: f64,
+/// Why a command failed, and what the process should exit with: **2** for bad input (a
+/// file that cannot be read or used, an option out of range: the user can fix it), **1** for
+/// a failure of the machine or the program (an output that cannot be written, an internal
+/// inconsistency), **0** quietly when stdout was closed early (`| head`). The same convention
+/// holds for `gesture-sim`.
+#[derive(Debug)]
+pub enum CliError {
+    /// Bad input: exit 2.
+    Input(String),
+    /// A failure: exit 1.
+    Failure(String),
+    /// Stdout is a closed pipe: stop quietly, exit 0.
+    BrokenPipe,
 }
 
-impl CorpusArgs {
-    /// Load options from the arguments.
-    pub fn options(&self) -> crate::corpus::LoadOptions {
-        let mut o = crate::corpus::LoadOptions::default();
-        if !self.effectors.is_empty() {
-            o.effectors = crate::motion::EffectorSpec::joints(self.effectors.iter().cloned());
+impl CliError {
+    /// The process exit status.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Self::Input(_) => 2,
+            Self::Failure(_) => 1,
+            Self::BrokenPipe => 0,
         }
-        o.max_mismatch_s = self.max_mismatch;
-        o
+    }
+
+    /// A failure of the machine or the program (exit 1).
+    pub fn failure(e: impl std::fmt::Display) -> Self {
+        Self::Failure(e.to_string())
     }
 }
 
-/// Control-layer options shared by `pack` and `eval-motion`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct ControlArgs {
-    /// Weight of transition costs against the fit of a segment to the belief (lower: gestures
-    /// follow the speech more and the recorded order less, with more cuts).
-    #[arg(long, default_value_t = crate::control::costs::CostParams::default().transition_weight)]
-    pub transition_weight: f64,
-    /// Weight of the pose jump when a segment ends in a cut (not scaled by the transition
-    /// weight).
-    #[arg(long, default_value_t = crate::control::costs::CostParams::default().junction_weight)]
-    pub junction_weight: f64,
-    /// Added to the cost of leaving a segment at an interruption frame.
-    #[arg(long, default_value_t = crate::control::costs::CostParams::default().interruption_penalty)]
-    pub interruption_penalty: f64,
-}
-
-impl ControlArgs {
-    /// Control-layer settings from the arguments (everything else at its default).
-    pub fn params(&self) -> crate::control::build::ControlParams {
-        let mut p = crate::control::build::ControlParams::default();
-        p.cost.transition_weight = self.transition_weight;
-        p.cost.interruption_penalty = self.interruption_penalty;
-        p.cost.junction_weight = self.junction_weight;
-        p
-    }
-
-    /// Refuses values that make no sense.
-    pub fn validate(&self) -> Result<(), CliError> {
-        for (name, v) in [
-            ("--transition-weight", self.transition_weight),
-            ("--interruption-penalty", self.interruption_penalty),
-            ("--junction-weight", self.junction_weight),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{name} must be a finite number >= 0, not {v}").into());
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Model options shared by `fit` and `eval-inference`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct ModelArgs {
-    /// Hidden states S.
-    #[arg(long, default_value_t = 12)]
-    pub states: usize,
-    /// Prosody clusters K.
-    #[arg(long, default_value_t = 12)]
-    pub clusters: usize,
-    /// HMM restarts (run in parallel; EM finds better optima with more).
-    #[arg(long, default_value_t = 16)]
-    pub restarts: usize,
-    /// Seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// CRF L2 regularization per training step (default: chosen by validation on the last
-    /// 20% of each training take).
-    #[arg(long)]
-    pub l2: Option<f64>,
-    /// HMM stickiness: extra self-transition pseudo-count as a fraction of steps per state.
-    #[arg(long, default_value_t = 0.0)]
-    pub stickiness: f64,
-}
-
-impl ModelArgs {
-    /// The fit settings for CRF window `window`.
-    pub fn config(&self, window: usize) -> crate::inference::train::FitConfig {
-        crate::inference::train::FitConfig {
-            states: self.states,
-            clusters: self.clusters,
-            window,
-            restarts: self.restarts,
-            seed: self.seed,
-            stickiness: self.stickiness,
-            l2: self.l2,
-            ..Default::default()
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Input(m) | Self::Failure(m) => f.write_str(m),
+            Self::BrokenPipe => f.write_str("stdout closed"),
         }
     }
 }
 
-/// An error of any command, printed as one line.
-pub type CliError = Box<dyn std::error::Error + Send + Sync>;
+impl std::error::Error for CliError {}
+
+/// Which library errors are the user's (exit 2) and which are failures (exit 1).
+pub trait ExitKind {
+    /// Whether the user's input is at fault.
+    fn is_input(&self) -> bool {
+        true
+    }
+}
+
+impl<E: std::error::Error + ExitKind> From<E> for CliError {
+    fn from(e: E) -> Self {
+        if e.is_input() {
+            Self::Input(e.to_string())
+        } else {
+            Self::Failure(e.to_string())
+        }
+    }
+}
+
+impl From<String> for CliError {
+    fn from(m: String) -> Self {
+        Self::Input(m)
+    }
+}
+
+impl From<&str> for CliError {
+    fn from(m: &str) -> Self {
+        Self::Input(m.to_string())
+    }
+}
+
+impl ExitKind for crate::corpus::CorpusError {}
+impl ExitKind for crate::corpus::DiscoverError {}
+impl ExitKind for crate::corpus::stats::StatsError {}
+impl ExitKind for crate::audio::AudioError {}
+impl ExitKind for crate::motion::BvhError {}
+impl ExitKind for crate::control::library::LibraryError {}
+impl ExitKind for crate::inference::model::ModelError {}
+impl ExitKind for crate::inference::train::FitError {}
+impl ExitKind for crate::synth::WriteError {
+    fn is_input(&self) -> bool {
+        false
+    }
+}
+impl ExitKind for crate::output::OutputError {
+    fn is_input(&self) -> bool {
+        false
+    }
+}
+impl ExitKind for serde_json::Error {
+    fn is_input(&self) -> bool {
+        false
+    }
+}
+impl ExitKind for crate::pack::PackError {
+    fn is_input(&self) -> bool {
+        crate::pack::PackError::is_input(self)
+    }
+}
+impl ExitKind for crate::evaluate::motion::EvalError {
+    fn is_input(&self) -> bool {
+        crate::evaluate::motion::EvalError::is_input(self)
+    }
+}
+
+/// Writes one line to stdout; a closed pipe is [`CliError::BrokenPipe`], any other error a
+/// failure. Used through [`outln!`], never `println!` (which panics on a closed pipe).
+pub(crate) fn write_line(args: std::fmt::Arguments<'_>) -> Result<(), CliError> {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "{args}").map_err(|e| {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            CliError::BrokenPipe
+        } else {
+            CliError::failure(format!("stdout: {e}"))
+        }
+    })
+}
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
@@ -191,7 +200,7 @@ pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
 }
 
 /// Checks that an output folder can be created.
-pub(crate) fn ensure_dir(dir: &PathBuf) -> Result<(), CliError> {
+pub(crate) fn ensure_dir(dir: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(dir)
-        .map_err(|e| format!("{}: cannot create folder: {e}", dir.display()).into())
+        .map_err(|e| CliError::Input(format!("{}: cannot create folder: {e}", dir.display())))
 }

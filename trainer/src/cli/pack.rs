@@ -2,7 +2,9 @@
 
 use std::path::PathBuf;
 
-use super::{CliError, ControlArgs, CorpusArgs};
+use super::args::{ControlArgs, CorpusArgs, TimingArgs};
+use super::CliError;
+use crate::output::write_atomic;
 use crate::pack::{pack, PackOptions};
 
 /// Arguments of `pack`.
@@ -35,6 +37,9 @@ pub struct PackArgs {
     /// Control-layer options.
     #[command(flatten)]
     pub control: ControlArgs,
+    /// Decision timing.
+    #[command(flatten)]
+    pub timing: TimingArgs,
 }
 
 /// Runs the command.
@@ -42,6 +47,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     a.control.validate()?;
     let opts = PackOptions {
         control: a.control.params(),
+        timing: a.timing.timing(),
         rig: a.rig.clone(),
         budget_bytes: a.budget_bytes,
         effectors: a.load.options().effectors,
@@ -49,17 +55,18 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     };
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
     outln!(
-        "wrote {}: {} bytes (front-end {}, inference {}, policy {}, library {}, rig {}, \
-         skeleton {})",
+        "wrote {}: {} bytes (front-end {}, inference {}, policy {}, control {}, library {}, \
+         rig {}, skeleton {})",
         a.out.display(),
         r.blob_bytes,
         r.section_bytes.front_end,
         r.section_bytes.inference,
         r.section_bytes.policy,
+        r.section_bytes.control,
         r.section_bytes.library,
         r.section_bytes.rig,
         r.section_bytes.skeleton
-    );
+    )?;
     outln!(
         "library: {} segments, {} exit points, {} frames; rig {} ({} channels)",
         r.segments,
@@ -67,7 +74,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.frames,
         r.rig,
         r.channels
-    );
+    )?;
     outln!(
         "successors: {} of {} kept ({:.2}% pruned{}); regret {:.4}%, agreement {:.2}% over {} simulated decisions",
         r.entries_kept,
@@ -78,7 +85,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         100.0 * r.regret,
         100.0 * r.agreement,
         r.regret_decisions
-    );
+    )?;
     outln!(
         "time: load {:.2} s, costs {:.2} s, value iteration {:.2} s, pruning {:.2} s, write {:.2} s, total {:.2} s",
         r.timings.load_s,
@@ -87,10 +94,10 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.timings.pruning_s,
         r.timings.write_s,
         r.timings.total_s
-    );
+    )?;
     if let Some(p) = &a.report {
         let text = serde_json::to_string_pretty(&r)?;
-        crate::blob::write_atomic(p, text.as_bytes())?;
+        write_atomic(p, text.as_bytes())?;
     }
     Ok(())
 }

@@ -59,6 +59,6 @@ pub fn run(a: &SynthArgs) -> Result<(), CliError> {
         w.truth.states.len(),
         a.out.join("truth.json").display(),
         start.elapsed().as_secs_f64()
-    );
+    )?;
     Ok(())
 }

@@ -1,8 +1,8 @@
 //! From a trained inference model and a library to a solved, pruned and quantized policy,
 //! with the regret it costs (what `gesture-train pack` runs).
 //!
-//! The quantized policy implements the runtime's [`PolicyTables`] and decides through the
-//! runtime's own [`select`], so the decisions measured here are the device's decisions.
+//! The regret is measured on the policy as the device reads it: the tables of the packed blob
+//! (the runtime's [`PolicyTables`]), deciding through the runtime's own [`select`].
 //! Regret is measured on simulated belief traces: a hidden state path drawn from the CRF's
 //! transition matrix, observed through a noisy channel (the true state gets 60% of the
 //! likelihood), filtered into beliefs; the controller walks the library following the
@@ -21,7 +21,6 @@ use super::library::Library;
 use super::mdp::{solve, transition_matrix, Action, MdpParams, Policy};
 use super::prune::{keep_best, prune};
 use crate::inference::model::InferenceModel;
-use crate::inference::quantize::QTable;
 
 /// Settings of the control layer.
 #[derive(Clone, Copy, Debug, Default)]
@@ -100,120 +99,6 @@ pub fn build(model: &InferenceModel, lib: &Library, params: &ControlParams) -> C
     }
 }
 
-/// The policy in the blob's form: i16 tables with scales, successor lists with i16 costs.
-#[derive(Clone, Debug)]
-pub struct QuantizedPolicy {
-    /// States.
-    pub states: usize,
-    /// Exit points: (segment, frame, end).
-    pub exits: Vec<(usize, usize, bool)>,
-    /// First exit point of each segment.
-    pub first_exit: Vec<usize>,
-    /// `U`, segments x states.
-    pub u: QTable,
-    /// `U_cont`, exit points x states (zeros at end exits).
-    pub u_cont: QTable,
-    /// Successors per exit: (segment, quantized cost).
-    pub succ: Vec<Vec<(usize, i16)>>,
-    /// Scale of the successor costs.
-    pub succ_scale: f32,
-}
-
-impl QuantizedPolicy {
-    /// Quantizes the kept part of `cm` for `lib`.
-    pub fn new(lib: &Library, cm: &ControlModel) -> Self {
-        let pol = &cm.policy;
-        let s = pol.states;
-        let u: Vec<f64> = pol.u.iter().flatten().copied().collect();
-        let u_cont: Vec<f64> = pol
-            .u_cont
-            .iter()
-            .flat_map(|o| o.clone().unwrap_or_else(|| vec![0.0; s]))
-            .collect();
-        let max_succ = cm
-            .kept
-            .iter()
-            .enumerate()
-            .flat_map(|(e, l)| l.iter().map(move |&c| pol.succ[e][c].abs()))
-            .fold(0.0f64, f64::max);
-        let succ_scale = if max_succ > 0.0 {
-            max_succ / 32767.0
-        } else {
-            1.0
-        };
-        let succ = cm
-            .kept
-            .iter()
-            .enumerate()
-            .map(|(e, l)| {
-                l.iter()
-                    .map(|&c| {
-                        (
-                            c,
-                            (pol.succ[e][c] / succ_scale)
-                                .round()
-                                .clamp(-32767.0, 32767.0) as i16,
-                        )
-                    })
-                    .collect()
-            })
-            .collect();
-        Self {
-            states: s,
-            exits: lib
-                .exits
-                .iter()
-                .map(|x| (x.segment, x.frame, x.end))
-                .collect(),
-            first_exit: lib.first_exit.clone(),
-            u: QTable::quantize(&u),
-            u_cont: QTable::quantize(&u_cont),
-            succ,
-            succ_scale: succ_scale as f32,
-        }
-    }
-
-    fn q(t: &QTable, i: usize) -> f32 {
-        t.bytes
-            .get(2 * i..2 * i + 2)
-            .map_or(0.0, |b| i16::from_le_bytes([b[0], b[1]]) as f32 * t.scale)
-    }
-}
-
-impl PolicyTables for QuantizedPolicy {
-    fn states(&self) -> usize {
-        self.states
-    }
-    fn exit_count(&self) -> usize {
-        self.exits.len()
-    }
-    fn exit_segment(&self, e: usize) -> usize {
-        self.exits[e].0
-    }
-    fn exit_frame(&self, e: usize) -> usize {
-        self.exits[e].1
-    }
-    fn exit_is_end(&self, e: usize) -> bool {
-        self.exits[e].2
-    }
-    fn first_exit(&self, c: usize) -> usize {
-        self.first_exit[c]
-    }
-    fn u(&self, c: usize, s: usize) -> f32 {
-        Self::q(&self.u, c * self.states + s)
-    }
-    fn u_cont(&self, e: usize, s: usize) -> f32 {
-        Self::q(&self.u_cont, e * self.states + s)
-    }
-    fn successor_count(&self, e: usize) -> usize {
-        self.succ[e].len()
-    }
-    fn successor(&self, e: usize, k: usize) -> (usize, f32) {
-        let (c, q) = self.succ[e][k];
-        (c, q as f32 * self.succ_scale)
-    }
-}
-
 /// Regret and agreement of the quantized policy on simulated belief traces.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RegretReport {
@@ -229,7 +114,7 @@ pub struct RegretReport {
 pub fn regret(
     lib: &Library,
     cm: &ControlModel,
-    q: &QuantizedPolicy,
+    q: &impl PolicyTables,
     model: &InferenceModel,
     decisions: usize,
     seed: u64,

@@ -3,9 +3,9 @@
 //! selection from the same library, the offline dynamic-programming sequence (posteriors that
 //! see the whole utterance), and, where the audio has its own motion capture, the real motion.
 //!
-//! The online sequence is what the device plays ([`play_device`]): the runtime's `Controller`
-//! over the quantized inference and the quantized, pruned policy, fed the audio's samples, with
-//! its decision timing (decisions on syllable onsets) and its detection latencies.
+//! The online sequence is what the device plays (`crate::evaluate::motion`): the packed
+//! blob's bytes through the runtime's device loop, fed the audio's samples, with its decision
+//! timing and its detection latencies.
 //!
 //! Each method yields a frame-by-frame sequence of library frames at the library's rate; its
 //! effector positions are the library take's own positions for those frames (the motion the
@@ -22,11 +22,6 @@
 //!   sigma^2))` with `d` the distance to the nearest motion beat (local minimum of mean hand
 //!   speed), `sigma = 0.3 s`, averaged over onsets.
 
-use gesture_runtime::controller::{Controller, ControllerError, ControllerEvent, DecisionTiming};
-use gesture_runtime::inference::{CrfWeights, GmmComponent};
-use gesture_runtime::player::LibraryFrames;
-use gesture_runtime::policy::{Choice, PolicyTables};
-use gesture_runtime::prosody::ProsodyConfig;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
@@ -61,7 +56,9 @@ pub struct Metrics {
     pub beat_alignment: f64,
 }
 
-fn is_cut(lib: &Library, from: usize, to: usize, at_end: bool) -> bool {
+/// Whether entering `to` from `from` (at its end exit, or at an interruption) is a cut: any
+/// switch but to the recorded next segment at the end.
+pub fn is_cut(lib: &Library, from: usize, to: usize, at_end: bool) -> bool {
     !(at_end && lib.segments[from].next == Some(to))
 }
 
@@ -275,81 +272,6 @@ pub fn cut_frames(seq: &[Played]) -> Vec<usize> {
         .filter(|(_, p)| p.cut)
         .map(|(i, _)| i)
         .collect()
-}
-
-/// Segment lengths of a library as the runtime player sees them (decisions do not depend on
-/// the poses, so no channels).
-pub struct SegmentLengths<'a>(pub &'a Library);
-
-impl LibraryFrames for SegmentLengths<'_> {
-    fn channels(&self) -> usize {
-        0
-    }
-    fn fps(&self) -> f32 {
-        self.0.fps as f32
-    }
-    fn segment_count(&self) -> usize {
-        self.0.segments.len()
-    }
-    fn segment_len(&self, c: usize) -> usize {
-        self.0.segments[c].len().max(1)
-    }
-    fn value(&self, _: usize, _: usize, _: usize) -> f32 {
-        0.0
-    }
-}
-
-/// What the device runs: the quantized policy `tables`, the quantized inference (`gmm`,
-/// `crf`), the front-end settings and the decision timing.
-pub struct Device<'a, T: PolicyTables> {
-    /// Policy tables.
-    pub tables: &'a T,
-    /// Prosody mixture.
-    pub gmm: &'a [GmmComponent],
-    /// CRF weights.
-    pub crf: CrfWeights<'a>,
-    /// Front-end settings.
-    pub config: ProsodyConfig,
-    /// When decisions happen.
-    pub timing: DecisionTiming,
-}
-
-/// Online play as the device does it: the runtime `Controller` (starting at segment 0) over
-/// `device`, fed `samples`. Returns `frames` played frames (the last one held if the audio
-/// ends earlier).
-pub fn play_device<T: PolicyTables>(
-    lib: &Library,
-    device: Device<'_, T>,
-    samples: &[i16],
-    frames: usize,
-) -> Result<Vec<Played>, ControllerError> {
-    let tables = device.tables;
-    let lengths = SegmentLengths(lib);
-    let mut ctl = Controller::new(&device.config, device.gmm, device.crf, tables, &lengths)?;
-    ctl.set_timing(device.timing);
-    let mut out: Vec<Played> = Vec::with_capacity(frames + 1);
-    let mut cut_next = false;
-    ctl.push(samples, &mut |ev| match ev {
-        ControllerEvent::Pose { segment, frame, .. } => {
-            out.push(Played {
-                segment,
-                frame,
-                cut: std::mem::take(&mut cut_next),
-            });
-        }
-        ControllerEvent::Decision { decision, .. } => {
-            if let Choice::Enter(c) = decision.choice {
-                let e = decision.exit;
-                cut_next = is_cut(lib, tables.exit_segment(e), c, tables.exit_is_end(e));
-            }
-        }
-        _ => {}
-    });
-    out.truncate(frames);
-    if let Some(&last) = out.last() {
-        out.resize(frames, Played { cut: false, ..last });
-    }
-    Ok(out)
 }
 
 /// Random selection: at end exits a uniformly random segment, otherwise continue.

@@ -4,7 +4,8 @@
 pub mod align;
 pub mod discover;
 pub mod load;
+pub mod stats;
 
 pub use align::{align, AlignedStep};
-pub use discover::{discover, Take};
+pub use discover::{discover, DiscoverError, Take};
 pub use load::{load_corpus, load_take, Corpus, CorpusError, LoadOptions, LoadedTake};

@@ -23,8 +23,8 @@
 //! any name with a left marker and `hand`/`wrist`; joints are: Hips, Spine, ...".
 //! Resolution never panics.
 
-use super::bvh::Skeleton;
 use super::fk::Target;
+use super::skeleton::Skeleton;
 
 /// Which points to follow.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -303,7 +303,7 @@ impl EffectorSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::motion::bvh::Joint;
+    use crate::motion::skeleton::Joint;
 
     fn skeleton(names: &[(&str, Option<usize>)]) -> Skeleton {
         Skeleton {

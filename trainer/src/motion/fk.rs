@@ -17,9 +17,10 @@
 //!
 //! ## Choices
 //!
-//! Plain `[f64; 3]` / `[[f64; 3]; 3]` math instead of nalgebra: FK needs only 3x3 products and
-//! matrix-vector products, the code stays short enough to check by eye against the convention
-//! above, and the trainer keeps one heavy dependency fewer on a 2-core build machine.
+//! The runtime's rotation module ([`gesture_runtime::rotation`], `[f64; 3]` and
+//! `[[f64; 3]; 3]`) instead of nalgebra: FK needs only 3x3 products and matrix-vector
+//! products, the simulator and the rig code use the same functions, and the trainer keeps one
+//! heavy dependency fewer.
 //!
 //! [`FkPlan`] evaluates only the joints a set of targets needs (the targets and their ancestor
 //! chains, parents first, as the depth-first joint order guarantees) and skips rotations nobody
@@ -31,45 +32,10 @@
 //! target indices are checked once when an [`FkPlan`] is built and the skeleton is checked
 //! against the motion's when it is run. Results are finite for finite input.
 
-use super::bvh::{Joint, Motion, Skeleton};
+use super::skeleton::{Joint, Motion, Skeleton};
 
-/// A point or vector in skeleton units.
-pub type Vec3 = [f64; 3];
-/// A 3x3 matrix, row-major (`m[row][col]`), acting on column vectors.
-pub type Mat3 = [[f64; 3]; 3];
-
-/// The identity matrix.
-pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-
-/// Rotation by `degrees` about axis 0 (X), 1 (Y) or 2 (Z), right-handed.
-pub fn axis_rotation(axis: usize, degrees: f64) -> Mat3 {
-    let (s, c) = degrees.to_radians().sin_cos();
-    match axis {
-        0 => [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]],
-        1 => [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]],
-        _ => [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]],
-    }
-}
-
-/// `a * b`.
-pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut m = [[0.0; 3]; 3];
-    for (r, row) in m.iter_mut().enumerate() {
-        for (c, x) in row.iter_mut().enumerate() {
-            *x = a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c];
-        }
-    }
-    m
-}
-
-/// `m * v`.
-pub fn mat_vec(m: &Mat3, v: &Vec3) -> Vec3 {
-    [
-        m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-        m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-        m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
-    ]
-}
+use gesture_runtime::rotation::{axis_rotation, identity, mat_mul, mat_vec};
+pub use gesture_runtime::rotation::{Mat3, Vec3};
 
 fn add(a: Vec3, b: Vec3) -> Vec3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
@@ -92,7 +58,7 @@ pub fn local_transform(joint: &Joint, values: &[f64]) -> (Mat3, Vec3) {
             t[c.axis()] = v;
         }
     }
-    (rot.unwrap_or(IDENTITY), t)
+    (rot.unwrap_or_else(identity), t)
 }
 
 /// World rotation and position of one joint.
@@ -349,7 +315,7 @@ impl FkPlan {
                 motion: motion.source().to_string(),
             });
         }
-        let mut rot = vec![IDENTITY; self.nodes.len()];
+        let mut rot = vec![identity(); self.nodes.len()];
         let mut pos = vec![[0.0; 3]; self.nodes.len()];
         let mut data = Vec::with_capacity(motion.frames() * self.targets.len());
         for row in motion.frame_rows() {

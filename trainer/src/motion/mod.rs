@@ -2,7 +2,9 @@
 //!
 //! | module | owns |
 //! |---|---|
-//! | [`bvh`] | BVH reading/writing; [`Skeleton`], [`Motion`], [`BvhError`] (file:line messages) |
+//! | [`skeleton`] | the motion types: [`Skeleton`], [`Joint`], [`Channel`], [`Motion`] |
+//! | [`bvh_read`] | the BVH reader, [`BvhError`] (file:line messages) |
+//! | [`bvh_write`] | the BVH writer |
 //! | [`fk`] | forward kinematics (per-joint rotation order), [`Positions`], the [`FkPlan`] fast path |
 //! | [`effectors`] | which points to follow: the two hands by name, or any named joints |
 //! | [`segment`] | mean effector speed, threshold cuts with hysteresis and a minimum length |
@@ -18,16 +20,16 @@
 //! that gate returns results or typed errors (bad parameters, missing joints). Everything is
 //! `f64` and single-threaded; allocation is proportional to the take's size.
 
-pub mod bvh;
+pub mod bvh_read;
+pub mod bvh_write;
 pub mod effectors;
 pub mod fk;
 pub mod kinematic;
 pub mod segment;
+pub mod skeleton;
 
-pub use bvh::{
-    parse_bvh, read_bvh, write_bvh, write_bvh_file, BvhError, BvhErrorKind, Channel, Joint, Motion,
-    MotionError, Skeleton,
-};
+pub use bvh_read::{parse_bvh, read_bvh, BvhError, BvhErrorKind};
+pub use bvh_write::{write_bvh, write_bvh_file};
 pub use effectors::{EffectorError, EffectorSpec, Effectors};
 pub use fk::{FkError, FkPlan, Positions, Target};
 pub use kinematic::{
@@ -35,6 +37,7 @@ pub use kinematic::{
     NormalizationError,
 };
 pub use segment::{Phase, Segment, SegmentParams, Threshold};
+pub use skeleton::{Channel, Joint, Motion, MotionError, Skeleton};
 
 /// Everything [`analyze`] learns about one take.
 #[derive(Clone, Debug, PartialEq)]

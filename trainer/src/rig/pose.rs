@@ -1,5 +1,5 @@
 //! Rig poses back on the library's skeleton: the blob's host-side `skeleton` section
-//! (docs/blob-format.md 3.6) as a trainer [`Skeleton`], and each played pose as a BVH frame.
+//! (docs/blob-format.md 3.7) as a [`Skeleton`], and each played pose as a BVH frame.
 //!
 //! ## How a pose becomes a frame (the choice, also stated in the format doc)
 //!
@@ -17,7 +17,7 @@
 //!   makes its chain equal `R` (joints above it in the chain keep their values), written in its
 //!   own channel order.
 //!
-//! So reading the rig back from the rebuilt frame (the trainer's `BoundRig::channel_values`)
+//! So reading the rig back from the rebuilt frame ([`BoundRig::channel_values`](super::BoundRig::channel_values))
 //! gives the pose again for one channel per joint and for Euler gimbals; two twist channels on
 //! one joint are applied in rig order and the second can disturb the first slightly. Joints no
 //! channel drives, and the root position, keep their rest values: a puppet rig moves only its
@@ -26,10 +26,14 @@
 //! Everything here is `f64`; nothing panics on a validated blob (the section's indices were
 //! checked at load).
 
-use gesture_runtime::blob::{DriveMode, SkeletonView};
-use gesture_trainer::motion::fk::{axis_rotation, local_transform, mat_mul, Mat3, IDENTITY};
-use gesture_trainer::motion::{Channel, Joint, Motion, MotionError, Skeleton};
-use gesture_trainer::rig::{euler_angles, twist_deg, Axis};
+use gesture_runtime::blob::{BvhChannel, DriveMode, SkeletonView};
+use gesture_runtime::rotation::{
+    axis_rotation, euler_angles, euler_matrix, identity, mat_mul, transpose, twist_deg, Mat3,
+};
+
+use super::Axis;
+use crate::motion::fk::local_transform;
+use crate::motion::{Joint, Motion, MotionError, Skeleton};
 
 /// The blob's skeleton, rest frame and rig channel drives, ready to rebuild frames.
 #[derive(Clone, Debug)]
@@ -41,25 +45,6 @@ pub struct PoseSkeleton {
     drives: Vec<(usize, usize, Axis, DriveMode)>,
 }
 
-const CODES: [Channel; 6] = [
-    Channel::Xposition,
-    Channel::Yposition,
-    Channel::Zposition,
-    Channel::Xrotation,
-    Channel::Yrotation,
-    Channel::Zrotation,
-];
-
-fn transpose(m: &Mat3) -> Mat3 {
-    let mut t = [[0.0; 3]; 3];
-    for (r, row) in m.iter().enumerate() {
-        for (c, v) in row.iter().enumerate() {
-            t[c][r] = *v;
-        }
-    }
-    t
-}
-
 impl PoseSkeleton {
     /// From a validated blob's skeleton section.
     pub fn from_blob(v: &SkeletonView<'_>) -> Result<Self, MotionError> {
@@ -68,11 +53,7 @@ impl PoseSkeleton {
                 name: v.joint_name(j).unwrap_or("").to_string(),
                 parent: v.parent(j),
                 offset: v.offset(j).map(f64::from),
-                channels: v
-                    .joint_channels(j)
-                    .filter_map(|i| v.channel_code(i))
-                    .map(|c| CODES[(c as usize).min(5)])
-                    .collect(),
+                channels: v.joint_channels(j).filter_map(|i| v.channel(i)).collect(),
                 end_site: v.end_site(j).map(|e| e.map(f64::from)),
             })
             .collect();
@@ -165,7 +146,7 @@ impl PoseSkeleton {
                 continue;
             }
             let joint = &self.skeleton.joints[j];
-            let want = [Channel::Xrotation, Channel::Yrotation, Channel::Zrotation][axis.index];
+            let want = BvhChannel::rotation(axis.index);
             if let Some(k) = joint.channels.iter().position(|&c| c == want) {
                 let sign = if axis.negated { -1.0 } else { 1.0 };
                 frame[self.starts[j] + k] = sign * v as f64;
@@ -190,7 +171,7 @@ impl PoseSkeleton {
                 .collect();
             let top = mine[0].0;
             let chain = self.chain(j, top);
-            let above = chain[..chain.len() - 1].iter().fold(IDENTITY, |acc, &k| {
+            let above = chain[..chain.len() - 1].iter().fold(identity(), |acc, &k| {
                 mat_mul(&acc, &self.local_rotation(&frame, k))
             });
             let mut r = mat_mul(&above, &self.local_rotation(&frame, j));
@@ -199,11 +180,7 @@ impl PoseSkeleton {
                 let target = sign * v;
                 match mode {
                     DriveMode::Twist => {
-                        let plain = Axis {
-                            index: axis.index,
-                            negated: false,
-                        };
-                        let old = twist_deg(&r, plain);
+                        let old = twist_deg(&r, axis.index);
                         r = mat_mul(&r, &axis_rotation(axis.index, target - old));
                     }
                     DriveMode::Euler(o) => {
@@ -212,13 +189,7 @@ impl PoseSkeleton {
                         if let Some(k) = order.iter().position(|&x| x == axis.index) {
                             a[k] = target;
                         }
-                        r = mat_mul(
-                            &mat_mul(
-                                &axis_rotation(order[0], a[0]),
-                                &axis_rotation(order[1], a[1]),
-                            ),
-                            &axis_rotation(order[2], a[2]),
-                        );
+                        r = euler_matrix(order, a);
                     }
                     DriveMode::Channel => {}
                 }

@@ -1,41 +1,43 @@
 //! Packing: a trained inference model plus a gesture library (any BVH files) plus a rig into
-//! one policy blob (DESIGN.md "New library, same model": only the control layer is computed
-//! here; the inference layer is reused as trained).
+//! one policy blob (docs/method.md "New library, same model": only the control layer is
+//! computed here; the inference layer is reused as trained).
 //!
 //! Steps: read the library and segment it like the corpus; bind the rig to its skeleton and
-//! turn every frame into channel angles; solve the control layer and prune it; if a byte budget
-//! is given, keep the best `k` successors per exit point with the largest `k` that fits;
-//! quantize; write atomically; measure the regret of the pruned, quantized policy against the
-//! float unpruned one on simulated belief traces.
+//! turn every frame into channel angles ([`assemble`]); solve the control layer and prune it;
+//! if a byte budget is given, keep the best `k` successors per exit point with the largest `k`
+//! that fits; quantize and encode with the runtime's writer; measure the regret of the
+//! pruned, quantized policy *read back from the bytes* against the float unpruned one on
+//! simulated belief traces. [`pack_model`] does all of this in memory and returns the bytes
+//! with everything an evaluation needs; [`pack`] also loads the model and writes the blob
+//! atomically.
 //!
 //! **One skeleton per library.** Every take of the library must have the same joint hierarchy
 //! (names, parents, channels; offsets may differ, the first take's are kept), so the blob's
-//! host-side `skeleton` section (docs/blob-format.md 3.6) can describe the motion the frames came
-//! from: the first take's skeleton, its first frame as the rest pose, and what each rig channel
-//! drives. A library that mixes skeletons is refused with the first difference; pack each
-//! skeleton family into its own blob. `--no-skeleton` leaves the section out (the device never
-//! reads it; it costs a few KiB for a 75-joint body).
+//! host-side `skeleton` section (docs/blob-format.md 3.7) can describe the motion the frames
+//! came from: the first take's skeleton, its first frame as the rest pose, and what each rig
+//! channel drives. A library that mixes skeletons is refused with the first difference; pack
+//! each skeleton family into its own blob. `no_skeleton` leaves the section out (the device
+//! never reads it; it costs a few KiB for a 75-joint body).
+
+pub mod assemble;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use gesture_runtime::blob::{Blob, FrontEndSection};
-use gesture_runtime::prosody::ProsodyConfig;
+use gesture_runtime::blob::encode::EncodeError;
+use gesture_runtime::blob::Blob;
+use gesture_runtime::controller::DecisionTiming;
 use serde::Serialize;
 
-use crate::blob::{
-    drives_of, encode, write_atomic, OwnedInference, OwnedLibrary, OwnedPayload, OwnedPolicy,
-    OwnedRig, OwnedSkeleton, PolicyInput, SegmentSpec,
-};
-use crate::control::build::{
-    build, fit_budget, regret, ControlModel, ControlParams, QuantizedPolicy,
-};
+use crate::control::build::{build, fit_budget, regret, ControlModel, ControlParams};
+use crate::control::library::LibraryError;
 use crate::control::Library;
 use crate::corpus::discover;
-use crate::inference::model::InferenceModel;
-use crate::inference::quantize::QuantizedInference;
+use crate::inference::model::{InferenceModel, ModelError};
 use crate::motion::{EffectorSpec, SegmentParams, Skeleton};
-use crate::rig::Rig;
+use crate::output::{write_atomic, OutputError};
+use crate::rig::{Rig, RigError};
+use assemble::{encode_with, parts, policy_section};
 
 /// Settings of a pack.
 #[derive(Clone, Debug, Default)]
@@ -46,6 +48,8 @@ pub struct PackOptions {
     pub budget_bytes: Option<usize>,
     /// Control-layer settings.
     pub control: ControlParams,
+    /// When the device decides (the blob's `control` section).
+    pub timing: DecisionTiming,
     /// End effectors for segmenting the library.
     pub effectors: EffectorSpec,
     /// Leave out the host-side skeleton section.
@@ -63,6 +67,8 @@ pub struct SectionBytes {
     pub inference: usize,
     /// Value tables and successor lists.
     pub policy: usize,
+    /// Controller settings.
+    pub control: usize,
     /// Library frames.
     pub library: usize,
     /// Rig calibration.
@@ -74,7 +80,7 @@ pub struct SectionBytes {
 /// Stage timings (s).
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct PackTimings {
-    /// Model, library and rig reading and binding.
+    /// Library and rig reading and binding.
     pub load_s: f64,
     /// psi and successor costs.
     pub costs_s: f64,
@@ -82,7 +88,7 @@ pub struct PackTimings {
     pub value_iteration_s: f64,
     /// Pruning (and budget truncation).
     pub pruning_s: f64,
-    /// Quantization, encoding and writing.
+    /// Quantization and encoding.
     pub write_s: f64,
     /// Regret simulation.
     pub regret_s: f64,
@@ -117,7 +123,7 @@ pub struct PackReport {
     pub agreement: f64,
     /// Decisions simulated for the regret.
     pub regret_decisions: usize,
-    /// Rig name and channels.
+    /// Rig name.
     pub rig: String,
     /// Rig channels.
     pub channels: usize,
@@ -128,63 +134,100 @@ pub struct PackReport {
 }
 
 /// Why packing failed.
-pub type PackError = Box<dyn std::error::Error + Send + Sync>;
-
-struct Parts {
-    inference: OwnedInference,
-    library: OwnedLibrary,
-    rig: OwnedRig,
-    front_end: FrontEndSection,
-    skeleton: Option<OwnedSkeleton>,
+#[derive(Debug, thiserror::Error)]
+pub enum PackError {
+    /// The model file.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// Finding the library's files.
+    #[error(transparent)]
+    Discover(#[from] crate::corpus::DiscoverError),
+    /// No BVH among the library's paths.
+    #[error("the library has no .bvh files")]
+    NoBvh,
+    /// Reading or segmenting the library.
+    #[error(transparent)]
+    Library(#[from] LibraryError),
+    /// The rig file or its binding (boxed: the largest error).
+    #[error(transparent)]
+    Rig(Box<RigError>),
+    /// Takes with different skeletons.
+    #[error(
+        "the library mixes skeletons: {first} and {other} differ ({diff}); pack one skeleton \
+         per library"
+    )]
+    MixedSkeletons {
+        /// The first take.
+        first: String,
+        /// The differing take.
+        other: String,
+        /// The first difference.
+        diff: String,
+    },
+    /// The budget cannot be met.
+    #[error(
+        "the blob does not fit {budget} bytes even with one successor per exit point \
+         ({size} bytes): use a smaller library, fewer rig channels, or a larger budget"
+    )]
+    Budget {
+        /// The budget.
+        budget: usize,
+        /// The smallest size reached.
+        size: usize,
+    },
+    /// The model's front-end settings are not ones this runtime accepts.
+    #[error("{0}")]
+    FrontEnd(String),
+    /// The writer refused the content (a packer bug or a dimension beyond the format).
+    #[error(transparent)]
+    Encode(#[from] EncodeError),
+    /// Writing the blob.
+    #[error(transparent)]
+    Output(#[from] OutputError),
 }
 
-fn policy_section(
+impl From<RigError> for PackError {
+    fn from(e: RigError) -> Self {
+        Self::Rig(Box::new(e))
+    }
+}
+
+impl PackError {
+    /// Whether the user's input is at fault (a file, an option), not the machine or the code.
+    pub fn is_input(&self) -> bool {
+        !matches!(
+            self,
+            Self::Output(_) | Self::Encode(EncodeError::Invalid(_) | EncodeError::Encode)
+        )
+    }
+}
+
+/// A blob packed in memory, with what an evaluation needs besides the bytes.
+#[derive(Clone, Debug)]
+pub struct Packed {
+    /// The blob (the runtime's writer checked it with `Blob::parse`).
+    pub bytes: Vec<u8>,
+    /// The report.
+    pub report: PackReport,
+    /// The library as segmented.
+    pub library: Library,
+    /// The solved control layer (float, unpruned policy and the kept successors).
+    pub control: ControlModel,
+}
+
+/// Packs `model` and the BVH files in `library` in memory (see the module docs).
+pub fn pack_model(
     model: &InferenceModel,
-    lib: &Library,
-    cm: &ControlModel,
-) -> Result<(OwnedPolicy, QuantizedPolicy), PackError> {
-    let q = QuantizedPolicy::new(lib, cm);
-    let exits: Vec<(usize, usize)> = q.exits.iter().map(|&(s, f, _)| (s, f)).collect();
-    let owned = OwnedPolicy::new(&PolicyInput {
-        states: model.states(),
-        segments: lib.segments.len(),
-        discount: cm.policy.discount,
-        u: &q.u,
-        u_cont: &q.u_cont,
-        exits: &exits,
-        successors: &q.succ,
-        succ_cost_scale: q.succ_scale,
-    })?;
-    Ok((owned, q))
-}
-
-fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, PackError> {
-    let payload = OwnedPayload {
-        front_end: parts.front_end,
-        inference: parts.inference.clone(),
-        policy: policy.clone(),
-        library: parts.library.clone(),
-        rig: parts.rig.clone(),
-        skeleton: parts.skeleton.clone(),
-    };
-    Ok(encode(&payload.payload())?)
-}
-
-/// Packs `model` and the BVH files in `library` into `out`; returns the report.
-pub fn pack(
-    model_path: &Path,
     library: &[PathBuf],
     opts: &PackOptions,
-    out: &Path,
-) -> Result<PackReport, PackError> {
+) -> Result<Packed, PackError> {
     let start = Instant::now();
-    let model = InferenceModel::load(model_path)?;
     let files: Vec<PathBuf> = discover(library)?
         .into_iter()
         .filter_map(|t| t.bvh)
         .collect();
     if files.is_empty() {
-        return Err("the library has no .bvh files".into());
+        return Err(PackError::NoBvh);
     }
     let lib = Library::from_files(
         &files,
@@ -200,79 +243,31 @@ pub fn pack(
     let first = &lib.takes[0];
     for t in &lib.takes[1..] {
         if let Some(diff) = skeleton_difference(first.motion.skeleton(), t.motion.skeleton()) {
-            return Err(format!(
-                "the library mixes skeletons: {} and {} differ ({diff}); pack one skeleton per \
-                 library",
-                first.source.display(),
-                t.source.display()
-            )
-            .into());
+            return Err(PackError::MixedSkeletons {
+                first: first.source.display().to_string(),
+                other: t.source.display().to_string(),
+                diff,
+            });
         }
     }
-    // Channel angles of every frame, take after take.
-    let mut frames: Vec<Vec<f32>> = Vec::new();
-    let mut offsets = Vec::with_capacity(lib.takes.len());
-    for t in &lib.takes {
-        let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
-        offsets.push(frames.len());
-        let values = bound
-            .take_values(&t.motion)
-            .ok_or_else(|| format!("{}: the rig does not fit this skeleton", t.source.display()))?;
-        frames.extend(values);
-    }
-    let segments: Vec<SegmentSpec> = lib
-        .segments
-        .iter()
-        .map(|s| SegmentSpec {
-            start: offsets[s.take] + s.start,
-            len: s.len(),
-            stroke: None,
-            label: 0,
-        })
-        .collect();
-    let cals: Vec<(String, gesture_runtime::rig::ChannelCal)> = rig
-        .channels
-        .iter()
-        .map(|c| (c.name.clone(), c.cal))
-        .collect();
-    let config = ProsodyConfig {
-        sample_rate_hz: model.sample_rate_hz,
-        ..ProsodyConfig::DEFAULT
-    };
-    let skeleton = if opts.no_skeleton {
-        None
-    } else {
-        let sk = first.motion.skeleton();
-        let bound = rig.bind(sk, &first.source.display().to_string())?;
-        let rest: Vec<f64> = first.motion.frame(0).unwrap_or(&[]).to_vec();
-        Some(OwnedSkeleton::new(sk, &rest, &drives_of(&bound)?)?)
-    };
-    let parts = Parts {
-        inference: OwnedInference::new(&QuantizedInference::new(&model.gmm, &model.crf))?,
-        library: OwnedLibrary::new(lib.fps, rig.channels.len(), &frames, &segments)?,
-        rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
-        front_end: FrontEndSection::from_config(&config),
-        skeleton,
-    };
+    let (parts, frames) = parts(model, &lib, &rig, opts)?;
     let load_s = start.elapsed().as_secs_f64();
 
-    let mut cm = build(&model, &lib, &opts.control);
+    let mut cm = build(model, &lib, &opts.control);
     let t_prune = Instant::now();
     let mut k = None;
     if let Some(budget) = opts.budget_bytes {
         let size = |c: &ControlModel| {
-            policy_section(&model, &lib, c)
-                .and_then(|(p, _)| encode_with(&parts, &p))
+            policy_section(model, &lib, c)
+                .and_then(|p| encode_with(&parts, &p))
                 .map_or(usize::MAX, |b| b.len())
         };
-        k = fit_budget(&model, &mut cm, budget, &size);
+        k = fit_budget(model, &mut cm, budget, &size);
         if k.is_none() {
-            return Err(format!(
-                "the blob does not fit {budget} bytes even with one successor per exit point \
-                 ({} bytes): use a smaller library, fewer rig channels, or a larger budget",
-                size(&cm)
-            )
-            .into());
+            return Err(PackError::Budget {
+                budget,
+                size: size(&cm),
+            });
         }
         if k == cm.pruned.iter().map(Vec::len).max() {
             k = None;
@@ -280,23 +275,24 @@ pub fn pack(
     }
     let pruning_extra = t_prune.elapsed().as_secs_f64();
     let t_write = Instant::now();
-    let (policy, q) = policy_section(&model, &lib, &cm)?;
+    let policy = policy_section(model, &lib, &cm)?;
     let bytes = encode_with(&parts, &policy)?;
-    write_atomic(out, &bytes)?;
-    let blob = Blob::parse(&bytes).map_err(|e| format!("{}: {e}", out.display()))?;
+    // The writer checked the bytes; what is measured below is what the device reads.
+    let blob = Blob::parse(&bytes).map_err(EncodeError::Invalid)?;
     let sizes = blob.section_sizes();
     let write_s = t_write.elapsed().as_secs_f64();
     let t_regret = Instant::now();
     let decisions = 20_000;
-    let r = regret(&lib, &cm, &q, &model, decisions, 7);
+    let r = regret(&lib, &cm, &blob, model, decisions, 7);
     let regret_s = t_regret.elapsed().as_secs_f64();
-    Ok(PackReport {
+    let report = PackReport {
         blob_bytes: bytes.len(),
         section_bytes: SectionBytes {
             header: gesture_runtime::blob::HEADER_LEN,
             front_end: sizes.front_end,
             inference: sizes.inference,
             policy: sizes.policy,
+            control: sizes.control,
             library: sizes.library,
             rig: sizes.rig,
             skeleton: sizes.skeleton,
@@ -313,7 +309,7 @@ pub fn pack(
         regret_decisions: decisions,
         rig: rig.name.clone(),
         channels: rig.channels.len(),
-        frames: frames.len(),
+        frames,
         timings: PackTimings {
             load_s,
             costs_s: cm.timings.costs,
@@ -323,7 +319,32 @@ pub fn pack(
             regret_s,
             total_s: start.elapsed().as_secs_f64(),
         },
+    };
+    Ok(Packed {
+        bytes,
+        report,
+        library: lib,
+        control: cm,
     })
+}
+
+/// Loads the model at `model_path`, packs it with the BVH files in `library` and writes the
+/// blob to `out` atomically; returns the report.
+pub fn pack(
+    model_path: &Path,
+    library: &[PathBuf],
+    opts: &PackOptions,
+    out: &Path,
+) -> Result<PackReport, PackError> {
+    let start = Instant::now();
+    let model = InferenceModel::load(model_path)?;
+    let mut packed = pack_model(&model, library, opts)?;
+    let t_write = Instant::now();
+    write_atomic(out, &packed.bytes)?;
+    let r = &mut packed.report;
+    r.timings.write_s += t_write.elapsed().as_secs_f64();
+    r.timings.total_s = start.elapsed().as_secs_f64();
+    Ok(packed.report)
 }
 
 /// The first structural difference between two skeletons (joint count, names, parents,

@@ -1,0 +1,555 @@
+//! The policy blob's errors: every variant of `BlobError` is reachable, each from the tiny
+//! blob with one field broken.
+
+mod common;
+
+use std::collections::BTreeSet;
+
+use common::*;
+use gesture_runtime::blob::*;
+use gesture_runtime::inference::{MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
+use gesture_runtime::prosody::ConfigError;
+use gesture_runtime::rig::{CalError, ChannelCal};
+
+const ALL: &[&str] = &[
+    "BlobTooShort",
+    "BadMagic",
+    "UnsupportedVersion",
+    "UnsupportedFlags",
+    "Truncated",
+    "TrailingBytes",
+    "BadCrc",
+    "Malformed",
+    "FrontEnd",
+    "ZeroCount",
+    "StateCountTooLarge",
+    "ClusterCountTooLarge",
+    "WindowTooLarge",
+    "TooManySegments",
+    "TooManyExits",
+    "TooManyChannels",
+    "TooManyFrames",
+    "StateCountMismatch",
+    "SegmentCountMismatch",
+    "TableLength",
+    "NotFinite",
+    "BadFrameRate",
+    "EmptySegment",
+    "SegmentOutOfFrames",
+    "StrokeOutOfRange",
+    "BadPwmPeriod",
+    "BadCalibration",
+    "ChannelNameCount",
+    "BadDiscount",
+    "ExitSegmentOutOfRange",
+    "ExitFrameOutOfRange",
+    "ExitsNotSorted",
+    "MissingEndExit",
+    "SuccessorOffsetsNotMonotone",
+    "SuccessorSegmentOutOfRange",
+    "SuccessorsNotSorted",
+    "NoSuccessors",
+    "BadControl",
+    "TooManyJoints",
+    "JointNameCount",
+    "BadParent",
+    "BadJointChannels",
+    "BadEndSite",
+    "BadDrive",
+];
+
+#[test]
+fn every_error_variant_is_reachable() {
+    let good = Tiny::new().encode();
+    let mut hit = BTreeSet::new();
+    let mut check = |bytes: &[u8], want: BlobError| {
+        let got = Blob::parse(bytes).err();
+        assert_eq!(got, Some(want));
+        // Every message is one line and says something.
+        let msg = want.to_string();
+        assert!(!msg.is_empty() && !msg.contains('\n'), "{msg}");
+        hit.insert(variant(&want));
+    };
+    let mutated = |f: &dyn Fn(&mut Tiny)| {
+        let mut t = Tiny::new();
+        f(&mut t);
+        t.encode()
+    };
+
+    // Header.
+    check(&good[..15], BlobError::BlobTooShort { len: 15 });
+    check(&[], BlobError::BlobTooShort { len: 0 });
+    let mut b = good.clone();
+    b[0] = b'X';
+    check(&b, BlobError::BadMagic);
+    for v in [1u16, 2, FORMAT_VERSION + 1] {
+        let mut b = good.clone();
+        b[4..6].copy_from_slice(&v.to_le_bytes());
+        check(&b, BlobError::UnsupportedVersion { found: v });
+    }
+    let mut b = good.clone();
+    b[6] = 1;
+    check(&b, BlobError::UnsupportedFlags { found: 1 });
+    let n = good.len() - HEADER_LEN;
+    check(
+        &good[..good.len() - 1],
+        BlobError::Truncated {
+            declared: n as u32,
+            available: n - 1,
+        },
+    );
+    let mut b = good.clone();
+    b.push(0);
+    check(
+        &b,
+        BlobError::TrailingBytes {
+            declared: n as u32,
+            available: n + 1,
+        },
+    );
+    let mut b = good.clone();
+    let last = b.len() - 1;
+    b[last] ^= 0x40;
+    let stored = u32::from_le_bytes(good[12..16].try_into().unwrap());
+    check(
+        &b,
+        BlobError::BadCrc {
+            stored,
+            computed: crc32(&b[HEADER_LEN..]),
+        },
+    );
+
+    // Payload decoding.
+    check(
+        &with_header(&[1, 2, 3]),
+        BlobError::Malformed {
+            section: Section::FrontEnd,
+        },
+    );
+    let mut b = good.clone();
+    b.push(0);
+    fix_crc(&mut b);
+    check(
+        &b,
+        BlobError::Malformed {
+            section: Section::Skeleton,
+        },
+    );
+    let mut b = good.clone();
+    b.truncate(b.len() - 3);
+    fix_crc(&mut b);
+    check(
+        &b,
+        BlobError::Malformed {
+            section: Section::Skeleton,
+        },
+    );
+    let mut b = mutated(&|t| t.skeleton = None);
+    b.truncate(b.len() - 3);
+    fix_crc(&mut b);
+    check(
+        &b,
+        BlobError::Malformed {
+            section: Section::Rig,
+        },
+    );
+
+    // front_end.
+    check(
+        &mutated(&|t| t.front_end.sample_rate_hz = 44_100),
+        BlobError::FrontEnd(ConfigError::UnsupportedSampleRate(44_100)),
+    );
+    check(
+        &mutated(&|t| t.front_end.margin_db = f32::NAN),
+        BlobError::FrontEnd(ConfigError::SyllableParams),
+    );
+
+    // inference.
+    check(
+        &mutated(&|t| t.states = 0),
+        BlobError::ZeroCount {
+            field: Field::States,
+        },
+    );
+    check(
+        &mutated(&|t| t.states = MAX_STATES as u8 + 1),
+        BlobError::StateCountTooLarge {
+            found: MAX_STATES as u32 + 1,
+        },
+    );
+    check(
+        &mutated(&|t| t.clusters = MAX_CLUSTERS as u8 + 1),
+        BlobError::ClusterCountTooLarge {
+            found: MAX_CLUSTERS as u32 + 1,
+        },
+    );
+    check(
+        &mutated(&|t| t.window = MAX_WINDOW as u8 + 1),
+        BlobError::WindowTooLarge {
+            found: MAX_WINDOW as u32 + 1,
+        },
+    );
+    check(
+        &mutated(&|t| {
+            t.gmm.pop();
+        }),
+        BlobError::TableLength {
+            field: Field::Gmm,
+            expected: GMM_RECORD_BYTES,
+            found: GMM_RECORD_BYTES - 1,
+        },
+    );
+    check(
+        &mutated(&|t| t.gmm[4..8].copy_from_slice(&f32::INFINITY.to_le_bytes())),
+        BlobError::NotFinite { field: Field::Gmm },
+    );
+    check(
+        &mutated(&|t| t.trans.0 = f32::NAN),
+        BlobError::NotFinite {
+            field: Field::CrfTrans,
+        },
+    );
+    check(
+        &mutated(&|t| t.obs.1.extend([0, 0])),
+        BlobError::TableLength {
+            field: Field::CrfObs,
+            expected: 4,
+            found: 6,
+        },
+    );
+
+    // library.
+    check(
+        &mutated(&|t| t.channels = 0),
+        BlobError::ZeroCount {
+            field: Field::Channels,
+        },
+    );
+    check(
+        &mutated(&|t| t.channels = MAX_CHANNELS as u16 + 1),
+        BlobError::TooManyChannels {
+            found: MAX_CHANNELS as u32 + 1,
+        },
+    );
+    check(&mutated(&|t| t.fps = 0.0), BlobError::BadFrameRate);
+    check(&mutated(&|t| t.fps = f32::NAN), BlobError::BadFrameRate);
+    check(
+        &mutated(&|t| t.frames = MAX_FRAMES as u32 + 1),
+        BlobError::TooManyFrames {
+            found: MAX_FRAMES as u32 + 1,
+        },
+    );
+    check(
+        &mutated(&|t| t.segments = MAX_SEGMENTS as u16 + 1),
+        BlobError::TooManySegments {
+            found: MAX_SEGMENTS as u32 + 1,
+        },
+    );
+    check(
+        &mutated(&|t| {
+            t.frame_values.truncate(10);
+        }),
+        BlobError::TableLength {
+            field: Field::FrameValues,
+            expected: 12,
+            found: 10,
+        },
+    );
+    check(
+        &mutated(&|t| t.frame_scales = le_f32(&[3e38, 0.0])),
+        BlobError::NotFinite {
+            field: Field::FrameScales,
+        },
+    );
+    check(
+        &mutated(&|t| t.seg_len = le_u16(&[3, 0])),
+        BlobError::EmptySegment { segment: 1 },
+    );
+    check(
+        &mutated(&|t| t.seg_start = le_u32(&[0, 4])),
+        BlobError::SegmentOutOfFrames { segment: 1 },
+    );
+    check(
+        &mutated(&|t| t.seg_start = le_u32(&[u32::MAX, 0])),
+        BlobError::SegmentOutOfFrames { segment: 0 },
+    );
+    check(
+        &mutated(&|t| t.strokes = le_u16(&[3, NO_STROKE])),
+        BlobError::StrokeOutOfRange { segment: 0 },
+    );
+
+    // rig.
+    check(&mutated(&|t| t.period_us = 0.0), BlobError::BadPwmPeriod);
+    check(
+        &mutated(&|t| {
+            let mut c = ChannelCal::HOBBY;
+            c.min_deg = 100.0;
+            t.calibration = calibration_record(&c).to_vec();
+        }),
+        BlobError::BadCalibration {
+            channel: 0,
+            error: CalError::EmptyRange,
+        },
+    );
+    check(
+        &mutated(&|t| t.calibration.clear()),
+        BlobError::TableLength {
+            field: Field::Calibration,
+            expected: CALIBRATION_RECORD_BYTES,
+            found: 0,
+        },
+    );
+    check(
+        &mutated(&|t| t.channel_names = "head\njaw".into()),
+        BlobError::ChannelNameCount {
+            expected: 1,
+            found: 2,
+        },
+    );
+
+    // policy.
+    check(
+        &mutated(&|t| t.p_states = 3),
+        BlobError::StateCountMismatch {
+            inference: 2,
+            policy: 3,
+        },
+    );
+    check(
+        &mutated(&|t| t.p_segments = 3),
+        BlobError::SegmentCountMismatch {
+            library: 2,
+            policy: 3,
+        },
+    );
+    check(
+        &mutated(&|t| t.exit_points = 0),
+        BlobError::ZeroCount {
+            field: Field::ExitPoints,
+        },
+    );
+    check(
+        &mutated(&|t| t.exit_points = MAX_EXITS as u16 + 1),
+        BlobError::TooManyExits {
+            found: MAX_EXITS as u32 + 1,
+        },
+    );
+    check(&mutated(&|t| t.discount = 1.5), BlobError::BadDiscount);
+    check(
+        &mutated(&|t| t.u.1.truncate(6)),
+        BlobError::TableLength {
+            field: Field::U,
+            expected: 8,
+            found: 6,
+        },
+    );
+    check(
+        &mutated(&|t| t.u_cont.0 = f32::INFINITY),
+        BlobError::NotFinite {
+            field: Field::UCont,
+        },
+    );
+    check(
+        &mutated(&|t| t.exits = le_u16(&[0, 2, 2, 1, 1, 2])),
+        BlobError::ExitSegmentOutOfRange {
+            exit: 1,
+            segment: 2,
+        },
+    );
+    check(
+        &mutated(&|t| t.exits = le_u16(&[0, 3, 1, 1, 1, 2])),
+        BlobError::ExitFrameOutOfRange { exit: 0, frame: 3 },
+    );
+    check(
+        &mutated(&|t| t.exits = le_u16(&[0, 2, 1, 2, 1, 1])),
+        BlobError::ExitsNotSorted { exit: 2 },
+    );
+    check(
+        &mutated(&|t| t.exits = le_u16(&[0, 1, 1, 1, 1, 2])),
+        BlobError::MissingEndExit { segment: 0 },
+    );
+    check(
+        &mutated(&|t| t.succ_offsets = le_u32(&[0, 2, 1, 4])),
+        BlobError::SuccessorOffsetsNotMonotone { exit: 2 },
+    );
+    check(
+        &mutated(&|t| t.succ_offsets = le_u32(&[1, 2, 2, 4])),
+        BlobError::SuccessorOffsetsNotMonotone { exit: 0 },
+    );
+    check(
+        &mutated(&|t| t.succ_offsets = le_u32(&[0, 2, 2, 5])),
+        BlobError::TableLength {
+            field: Field::Succ,
+            expected: 20,
+            found: 16,
+        },
+    );
+    check(
+        &mutated(&|t| t.succ_scale = f32::NAN),
+        BlobError::NotFinite { field: Field::Succ },
+    );
+    check(
+        &mutated(&|t| t.succ = le_i16(&[0, 5, 1, -5, 0, 7, 2, 0])),
+        BlobError::SuccessorSegmentOutOfRange {
+            entry: 3,
+            segment: 2,
+        },
+    );
+    check(
+        &mutated(&|t| t.succ = le_i16(&[1, 5, 0, -5, 0, 7, 1, 0])),
+        BlobError::SuccessorsNotSorted { exit: 0 },
+    );
+    check(
+        &mutated(&|t| {
+            t.succ_offsets = le_u32(&[0, 2, 2, 2]);
+            t.succ.truncate(8);
+        }),
+        BlobError::NoSuccessors { exit: 2 },
+    );
+
+    // control.
+    check(
+        &mutated(&|t| t.control.sync_to_onsets = 2),
+        BlobError::BadControl {
+            field: Field::SyncToOnsets,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.onset_window_ms = 1001),
+        BlobError::BadControl {
+            field: Field::OnsetWindow,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.max_wait_ms = 5001),
+        BlobError::BadControl {
+            field: Field::MaxWait,
+        },
+    );
+
+    // skeleton.
+    let sk = |f: &dyn Fn(&mut TinySkeleton)| {
+        mutated(&|t| {
+            if let Some(s) = t.skeleton.as_mut() {
+                f(s)
+            }
+        })
+    };
+    check(
+        &sk(&|s| s.joints = 0),
+        BlobError::ZeroCount {
+            field: Field::Joints,
+        },
+    );
+    check(
+        &sk(&|s| s.joints = MAX_JOINTS as u16 + 1),
+        BlobError::TooManyJoints {
+            found: MAX_JOINTS as u32 + 1,
+        },
+    );
+    check(
+        &sk(&|s| s.joint_names = "hips".into()),
+        BlobError::JointNameCount {
+            expected: 2,
+            found: 1,
+        },
+    );
+    check(
+        &sk(&|s| s.offsets.truncate(20)),
+        BlobError::TableLength {
+            field: Field::Offsets,
+            expected: 24,
+            found: 20,
+        },
+    );
+    check(
+        &sk(&|s| s.channel_counts = vec![6, 2]),
+        BlobError::TableLength {
+            field: Field::ChannelCodes,
+            expected: 8,
+            found: 9,
+        },
+    );
+    check(
+        &sk(&|s| s.rest.truncate(32)),
+        BlobError::TableLength {
+            field: Field::Rest,
+            expected: 36,
+            found: 32,
+        },
+    );
+    check(
+        &sk(&|s| s.end_sites.push(0)),
+        BlobError::TableLength {
+            field: Field::EndSites,
+            expected: 14,
+            found: 15,
+        },
+    );
+    check(
+        &sk(&|s| s.drives.push(0)),
+        BlobError::TableLength {
+            field: Field::Drives,
+            expected: 6,
+            found: 7,
+        },
+    );
+    check(
+        &sk(&|s| s.offsets[4..8].copy_from_slice(&f32::NAN.to_le_bytes())),
+        BlobError::NotFinite {
+            field: Field::Offsets,
+        },
+    );
+    check(
+        &sk(&|s| s.rest[0..4].copy_from_slice(&f32::INFINITY.to_le_bytes())),
+        BlobError::NotFinite { field: Field::Rest },
+    );
+    check(
+        &sk(&|s| s.end_sites[2..6].copy_from_slice(&f32::NAN.to_le_bytes())),
+        BlobError::NotFinite {
+            field: Field::EndSites,
+        },
+    );
+    check(
+        &sk(&|s| s.parents = le_u16(&[ROOT_PARENT, 1])),
+        BlobError::BadParent { joint: 1 },
+    );
+    check(
+        &sk(&|s| s.channel_codes[8] = 6),
+        BlobError::BadJointChannels { joint: 1 },
+    );
+    check(
+        &sk(&|s| s.channel_codes[1] = 0),
+        BlobError::BadJointChannels { joint: 0 },
+    );
+    check(
+        &sk(&|s| s.end_sites[0] = 2),
+        BlobError::BadEndSite { entry: 0 },
+    );
+    check(
+        &sk(&|s| s.drives[0] = 2),
+        BlobError::BadDrive { channel: 0 },
+    );
+    check(
+        &sk(&|s| s.drives[4] = 6),
+        BlobError::BadDrive { channel: 0 },
+    );
+    check(
+        &sk(&|s| s.drives[5] = 8),
+        BlobError::BadDrive { channel: 0 },
+    );
+    // The chain top must be the joint or an ancestor: hips (0) above head (1) is fine, head
+    // above hips is not.
+    assert!(Blob::parse(&sk(&|s| s.drives[2] = 0)).is_ok());
+    check(
+        &sk(&|s| {
+            s.drives[0] = 0;
+            s.drives[2] = 1;
+        }),
+        BlobError::BadDrive { channel: 0 },
+    );
+
+    let all: BTreeSet<&str> = ALL.iter().copied().collect();
+    let missing: Vec<_> = all.difference(&hit).collect();
+    assert!(missing.is_empty(), "never triggered: {missing:?}");
+}

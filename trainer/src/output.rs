@@ -1,0 +1,106 @@
+//! Writing output files atomically: every file a command writes goes through a temporary file
+//! beside it (a distinct name, made by `tempfile`), flushed to disk, then renamed over the
+//! target, so the target is either the complete new file or untouched. On any error the
+//! temporary file is removed (it is deleted when dropped unless renamed).
+//!
+//! Errors name the *target* path, never the temporary one.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Writing `path` failed.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: cannot write: {source}", path.display())]
+pub struct OutputError {
+    /// The file that was to be written.
+    pub path: PathBuf,
+    /// The cause.
+    pub source: std::io::Error,
+}
+
+/// Writes `bytes` to `path` atomically (see the module docs).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), OutputError> {
+    write_atomic_with(path, |f| f.write_all(bytes))
+}
+
+/// Creates a temporary file beside `path`, lets `write` fill it, flushes it to disk and
+/// renames it over `path`. `write` gets the open file (and may also reopen it by its path,
+/// `f.path()`).
+pub fn write_atomic_with(
+    path: &Path,
+    write: impl FnOnce(&mut tempfile::NamedTempFile) -> std::io::Result<()>,
+) -> Result<(), OutputError> {
+    let err = |source| OutputError {
+        path: path.to_path_buf(),
+        source: plain(source),
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| err(std::io::Error::other("not a file name")))?;
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(name);
+    prefix.push(".");
+    let mut tmp = tempfile::Builder::new()
+        .prefix(&prefix)
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(err)?;
+    write(&mut tmp).map_err(err)?;
+    tmp.as_file_mut().flush().map_err(err)?;
+    tmp.as_file().sync_all().map_err(err)?;
+    tmp.persist(path).map_err(|e| err(e.error))?;
+    Ok(())
+}
+
+/// The operating system's error without the temporary file's path (which `tempfile` appends
+/// as " at path ..."): messages name the target only.
+fn plain(e: std::io::Error) -> std::io::Error {
+    let text = e.to_string();
+    match text.find(" at path ") {
+        Some(i) => std::io::Error::new(e.kind(), text[..i].to_string()),
+        None => e,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_replace_the_file_and_leave_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.bin");
+        write_atomic(&p, b"one").unwrap();
+        write_atomic(&p, b"two").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"two");
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 1);
+    }
+
+    #[test]
+    fn a_failed_write_keeps_the_old_file_and_removes_the_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.bin");
+        write_atomic(&p, b"old").unwrap();
+        let e = write_atomic_with(&p, |_| Err(std::io::Error::other("disk full"))).unwrap_err();
+        assert!(e.to_string().starts_with(&p.display().to_string()), "{e}");
+        assert_eq!(std::fs::read(&p).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn an_output_in_a_missing_folder_names_the_output() {
+        let p = Path::new("/nonexistent-folder-for-a-test/x.json");
+        let e = write_atomic(p, b"{}").unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("/nonexistent-folder-for-a-test/x.json"),
+            "{e}"
+        );
+        assert!(!e.to_string().contains(".tmp"), "{e}");
+    }
+}

@@ -1,0 +1,162 @@
+//! The blob's sections from a model, a library and a rig: the inference layer as trained, the
+//! library's frames as rig channel angles, the rig's calibration, the front-end settings,
+//! the controller's timing and (optionally) the library's skeleton; then the policy section
+//! of a solved control layer, and the encoding of it all with the runtime's writer.
+
+use gesture_runtime::blob::encode::{
+    encode, EncodeError, JointSpec, OwnedInference, OwnedLibrary, OwnedPolicy, OwnedRig,
+    OwnedSkeleton, PolicyInput, SegmentSpec,
+};
+use gesture_runtime::blob::{ControlSection, FrontEndSection, Payload};
+use gesture_runtime::prosody::ProsodyConfig;
+use gesture_runtime::rig::ChannelCal;
+
+use super::{PackError, PackOptions};
+use crate::control::build::ControlModel;
+use crate::control::Library;
+use crate::inference::model::InferenceModel;
+use crate::inference::quantize::inference_section;
+use crate::motion::Skeleton;
+use crate::rig::Rig;
+
+/// Every section but the policy.
+pub struct Parts {
+    front_end: FrontEndSection,
+    inference: OwnedInference,
+    control: ControlSection,
+    library: OwnedLibrary,
+    rig: OwnedRig,
+    skeleton: Option<OwnedSkeleton>,
+}
+
+/// The joints of `skeleton` as the writer takes them.
+pub fn joint_specs(skeleton: &Skeleton) -> Vec<JointSpec<'_>> {
+    skeleton
+        .joints
+        .iter()
+        .map(|j| JointSpec {
+            name: &j.name,
+            parent: j.parent,
+            offset: j.offset,
+            channels: &j.channels,
+            end_site: j.end_site,
+        })
+        .collect()
+}
+
+/// The sections of `lib` through `rig` (the takes must share a skeleton); also returns the
+/// number of frames stored.
+pub fn parts(
+    model: &InferenceModel,
+    lib: &Library,
+    rig: &Rig,
+    opts: &PackOptions,
+) -> Result<(Parts, usize), PackError> {
+    // Channel angles of every frame, take after take.
+    let mut frames: Vec<Vec<f32>> = Vec::new();
+    let mut offsets = Vec::with_capacity(lib.takes.len());
+    for t in &lib.takes {
+        let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
+        offsets.push(frames.len());
+        let values = bound.take_values(&t.motion).ok_or_else(|| {
+            EncodeError::Inconsistent(format!(
+                "{}: the rig does not fit this skeleton",
+                t.source.display()
+            ))
+        })?;
+        frames.extend(values);
+    }
+    let segments: Vec<SegmentSpec> = lib
+        .segments
+        .iter()
+        .map(|s| SegmentSpec {
+            start: offsets[s.take] + s.start,
+            len: s.len(),
+            stroke: None,
+            label: 0,
+        })
+        .collect();
+    let cals: Vec<(String, ChannelCal)> = rig
+        .channels
+        .iter()
+        .map(|c| (c.name.clone(), c.cal))
+        .collect();
+    let config = ProsodyConfig {
+        sample_rate_hz: model.sample_rate_hz,
+        ..ProsodyConfig::DEFAULT
+    };
+    config
+        .validate()
+        .map_err(|e| PackError::FrontEnd(format!("the model's front-end settings: {e}")))?;
+    let skeleton = if opts.no_skeleton {
+        None
+    } else {
+        let first = &lib.takes[0];
+        let sk = first.motion.skeleton();
+        let bound = rig.bind(sk, &first.source.display().to_string())?;
+        let rest: Vec<f64> = first.motion.frame(0).unwrap_or(&[]).to_vec();
+        let drives = bound.drives().ok_or(EncodeError::TooLarge {
+            what: "skeleton joints",
+            value: sk.joints.len(),
+            ty: "u16",
+        })?;
+        Some(OwnedSkeleton::new(&joint_specs(sk), &rest, &drives)?)
+    };
+    let n = frames.len();
+    Ok((
+        Parts {
+            front_end: FrontEndSection::from_config(&config),
+            inference: inference_section(&model.gmm, &model.crf)?,
+            control: ControlSection::from_timing(&opts.timing),
+            library: OwnedLibrary::new(lib.fps, rig.channels.len(), &frames, &segments)?,
+            rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
+            skeleton,
+        },
+        n,
+    ))
+}
+
+/// The policy section of the kept part of `cm`.
+pub fn policy_section(
+    model: &InferenceModel,
+    lib: &Library,
+    cm: &ControlModel,
+) -> Result<OwnedPolicy, EncodeError> {
+    let pol = &cm.policy;
+    let s = pol.states;
+    let u: Vec<f64> = pol.u.iter().flatten().copied().collect();
+    let u_cont: Vec<f64> = pol
+        .u_cont
+        .iter()
+        .flat_map(|o| o.clone().unwrap_or_else(|| vec![0.0; s]))
+        .collect();
+    let exits: Vec<(usize, usize)> = lib.exits.iter().map(|x| (x.segment, x.frame)).collect();
+    let successors: Vec<Vec<(usize, f64)>> = cm
+        .kept
+        .iter()
+        .enumerate()
+        .map(|(e, l)| l.iter().map(|&c| (c, pol.succ[e][c])).collect())
+        .collect();
+    OwnedPolicy::new(&PolicyInput {
+        states: model.states(),
+        segments: lib.segments.len(),
+        discount: pol.discount,
+        u: &u,
+        u_cont: &u_cont,
+        exits: &exits,
+        successors: &successors,
+    })
+}
+
+/// The blob's bytes for `parts` and `policy`.
+pub fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, EncodeError> {
+    encode(&Payload {
+        front_end: parts.front_end,
+        inference: parts.inference.section(),
+        policy: policy.section(),
+        control: parts.control,
+        library: parts.library.section(),
+        rig: parts.rig.section(),
+        skeleton: parts.skeleton.as_ref().map(OwnedSkeleton::section),
+    })
+}
