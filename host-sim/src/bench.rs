@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use gesture_runtime::prosody::{Event, FrontEnd, ProsodyConfig};
 use gesture_trainer::audio;
 
-use crate::cli::CliError;
+use crate::error::SimError;
 use gesture_trainer::synth;
 
 /// Seed of the synthetic benchmark signal.
@@ -65,7 +65,7 @@ pub fn measure(
     config: &ProsodyConfig,
     runs: u32,
     source: String,
-) -> Result<BenchReport, CliError> {
+) -> Result<BenchReport, SimError> {
     let mut times = Vec::with_capacity(runs as usize);
     let (mut frames, mut steps) = (0u64, 0u64);
     for _ in 0..runs.max(1) {
@@ -101,7 +101,7 @@ pub fn run(
     runs: u32,
     wav: Option<&Path>,
     out: &mut impl Write,
-) -> Result<(), CliError> {
+) -> Result<(), SimError> {
     let config = ProsodyConfig::DEFAULT;
     let rate = config.sample_rate_hz;
     let (samples, source) = match wav {

@@ -1,9 +1,10 @@
 //! The `gesture-sim` command line: argument definitions, dispatch, exit codes, error lines.
 //!
-//! Exit codes: 0 success (also when stdout is closed early, e.g. `| head`); 1 an internal
-//! failure (writing output failed, the front-end refused its own default configuration);
-//! 2 bad input (an unreadable or unsupported file, a malformed reference) and, from clap, bad
-//! usage. Every error is one line on stderr: `gesture-sim: <file>: <reason>`.
+//! Exit codes (the same convention as `gesture-train`): 0 success (also when stdout is closed
+//! early, e.g. `| head`); 2 bad input (an unreadable or unsupported file, a malformed
+//! reference, an option out of range, and, from clap, bad usage); 1 a failure of the machine
+//! or the program (writing output failed, no audio backend). Every error is one line on
+//! stderr: `gesture-sim: <file>: <reason>` ([`SimError::exit_code`]).
 //!
 //! Output goes through one `BufWriter` on the locked stdout; nothing here uses `println!`, so
 //! a closed pipe is an ordinary error value and never a panic.
@@ -13,11 +14,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use gesture_runtime::prosody::ConfigError;
-use gesture_trainer::audio::AudioError;
 
-use crate::eval::ParseError;
-use crate::live::{self, LiveError, LiveOptions};
+use crate::error::SimError;
+use crate::live::{self, LiveOptions};
 use crate::run::{self as run_cmd, RunConfig, RunError};
 use crate::{bench, eval_cmd, prosody_cmd};
 
@@ -126,66 +125,8 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
     }
 }
 
-/// Why a subcommand failed.
-#[derive(Debug, thiserror::Error)]
-pub enum CliError {
-    /// An audio file could not be loaded (its message names the file).
-    #[error(transparent)]
-    Audio(#[from] AudioError),
-    /// A data file could not be read.
-    #[error("{}: {source}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// The OS error.
-        source: io::Error,
-    },
-    /// A reference or prompts file is malformed.
-    #[error("{}: {source}", path.display())]
-    Data {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong.
-        source: ParseError,
-    },
-    /// The front-end refused its configuration (a bug: the default is used).
-    #[error("front-end configuration: {0}")]
-    Config(#[from] ConfigError),
-    /// Writing the output failed.
-    #[error("writing output: {0}")]
-    Output(#[from] io::Error),
-    /// `run` failed (boxed: rig errors are large).
-    #[error(transparent)]
-    Run(Box<RunError>),
-    /// `live` or `devices` failed.
-    #[error(transparent)]
-    Live(#[from] LiveError),
-    /// `demo` failed.
-    #[error(transparent)]
-    Demo(#[from] crate::demo::DemoError),
-}
-
-impl From<RunError> for CliError {
-    fn from(e: RunError) -> Self {
-        Self::Run(Box::new(e))
-    }
-}
-
-impl CliError {
-    /// The process exit status for this error.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Self::Audio(_) | Self::Read { .. } | Self::Data { .. } => 2,
-            Self::Config(_) | Self::Output(_) => 1,
-            Self::Run(e) => e.exit_code(),
-            Self::Live(e) => e.exit_code(),
-            Self::Demo(_) => 1,
-        }
-    }
-}
-
 /// Runs a parsed command line, writing results to `out`.
-pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), CliError> {
+pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
     match &cli.command {
         Command::Prosody { wav, syllables } => prosody_cmd::run(wav, *syllables, out),
         Command::EvalProsody { data, json } => eval_cmd::run(data.as_deref(), *json, out),
@@ -242,10 +183,10 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), CliError> {
 /// module docs).
 pub fn run(cli: &Cli) -> ExitCode {
     let mut out = BufWriter::new(io::stdout().lock());
-    let result = execute(cli, &mut out).and_then(|()| out.flush().map_err(CliError::Output));
+    let result = execute(cli, &mut out).and_then(|()| out.flush().map_err(SimError::Output));
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(CliError::Output(e)) if e.kind() == io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(SimError::Output(e)) if e.kind() == io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
         Err(e) => {
             // If stderr is gone too there is nobody left to tell.
             let _ = writeln!(io::stderr(), "gesture-sim: {e}");

@@ -19,6 +19,7 @@
 //! Progress bars go to stderr (hidden when it is not a terminal); the summary to stdout.
 //! Every step is seeded, so two demos write the same files (but for timings).
 
+use gesture_trainer::progress::{progress_bar as bar, spinner};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -54,38 +55,50 @@ impl Default for DemoParams {
     }
 }
 
-fn bar(len: u64, what: &str) -> indicatif::ProgressBar {
-    gesture_trainer::cli::progress_bar(len, what)
-}
-
-fn spinner(what: &str) -> indicatif::ProgressBar {
-    let pb = indicatif::ProgressBar::new_spinner();
-    pb.set_message(what.to_string());
-    pb.enable_steady_tick(std::time::Duration::from_millis(120));
-    pb
-}
-
 /// Why the demo failed (one line; the step is named).
 #[derive(Debug, thiserror::Error)]
 #[error("demo, {step}: {reason}")]
 pub struct DemoError {
     step: &'static str,
     reason: String,
+    /// The user's input is at fault (an output folder that cannot be made).
+    input: bool,
+}
+
+impl DemoError {
+    /// The process exit status: 2 for an unusable output folder, 1 otherwise.
+    pub fn exit_code(&self) -> u8 {
+        if self.input {
+            2
+        } else {
+            1
+        }
+    }
 }
 
 fn at<E: std::fmt::Display>(step: &'static str) -> impl Fn(E) -> DemoError {
     move |e| DemoError {
         step,
         reason: e.to_string(),
+        input: false,
     }
+}
+
+/// Creates `dir`; an error names it and is the user's to fix.
+fn make_dir(dir: &Path) -> Result<(), DemoError> {
+    std::fs::create_dir_all(dir).map_err(|e| DemoError {
+        step: "creating the output folder",
+        reason: format!("{}: {e}", dir.display()),
+        input: true,
+    })
 }
 
 /// Runs the demo into `dir`, printing what it did to `out`.
 pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), DemoError> {
     let start = Instant::now();
-    std::fs::create_dir_all(dir).map_err(at("creating the folder"))?;
+    make_dir(dir)?;
     let corpus = dir.join("corpus");
-    std::fs::create_dir_all(&corpus).map_err(at("creating the folder"))?;
+    make_dir(&corpus)?;
 
     // 1. Corpus.
     let t = Instant::now();
@@ -182,7 +195,7 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
 
     // 4. A new utterance (another seed: another speaker and sentence).
     let utter_dir = dir.join(".utterance");
-    std::fs::create_dir_all(&utter_dir).map_err(at("creating the folder"))?;
+    make_dir(&utter_dir)?;
     let up = SynthParams {
         minutes: params.utterance_s / 60.0,
         seed: 2024,

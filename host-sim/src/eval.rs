@@ -1,8 +1,8 @@
 //! Accuracy of the prosody front-end against Praat: pure functions, no I/O.
 //!
-//! The metrics are exactly those of `shared/tools/prosody_compare.py`, so that
-//! `gesture-sim eval-prosody` and `gesture-sim prosody x.wav > ours.csv;
-//! prosody_compare.py ours.csv praat.csv` print the same numbers:
+//! The metrics are the usual comparison of a pitch/intensity track with Praat's, defined here
+//! so that `gesture-sim eval-prosody` and a comparison of `gesture-sim prosody x.wav` with a
+//! Praat CSV by the same rules print the same numbers:
 //!
 //! - frames are matched by nearest time: each reference frame takes the closer of the two
 //!   neighbouring frames of ours (the earlier one on a tie) if it lies within 6 ms;

@@ -17,7 +17,7 @@ use gesture_runtime::prosody::{ProsodyConfig, Step};
 use gesture_trainer::{audio, features};
 use serde_json::{json, Value};
 
-use crate::cli::CliError;
+use crate::error::SimError;
 use crate::eval::{self, Metrics, Pair, Worst};
 use crate::prosody_cmd::write_frames_csv;
 
@@ -82,15 +82,15 @@ pub struct Report {
     pub syllables: Vec<SyllableResult>,
 }
 
-fn read_text(path: &Path) -> Result<String, CliError> {
-    std::fs::read_to_string(path).map_err(|source| CliError::Read {
+fn read_text(path: &Path) -> Result<String, SimError> {
+    std::fs::read_to_string(path).map_err(|source| SimError::Read {
         path: path.to_owned(),
         source,
     })
 }
 
-fn wav_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), CliError> {
-    let entries = std::fs::read_dir(dir).map_err(|source| CliError::Read {
+fn wav_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), SimError> {
+    let entries = std::fs::read_dir(dir).map_err(|source| SimError::Read {
         path: dir.to_owned(),
         source,
     })?;
@@ -106,7 +106,7 @@ fn wav_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), CliError> {
     Ok(())
 }
 
-fn analyse(path: &Path) -> Result<(Vec<eval::TrackFrame>, Vec<Step>), CliError> {
+fn analyse(path: &Path) -> Result<(Vec<eval::TrackFrame>, Vec<Step>), SimError> {
     let config = ProsodyConfig::DEFAULT;
     let pcm = audio::load_wav_at(path, config.sample_rate_hz)?;
     let (frames, steps) = features::prosody_of(&pcm.samples, &config)?;
@@ -114,7 +114,7 @@ fn analyse(path: &Path) -> Result<(Vec<eval::TrackFrame>, Vec<Step>), CliError> 
     let mut csv = Vec::new();
     write_frames_csv(&mut csv, &frames)?;
     let track =
-        eval::parse_track_csv(&String::from_utf8_lossy(&csv)).map_err(|source| CliError::Data {
+        eval::parse_track_csv(&String::from_utf8_lossy(&csv)).map_err(|source| SimError::Data {
             path: path.to_owned(),
             source,
         })?;
@@ -126,7 +126,7 @@ fn relative(dir: &Path, p: &Path) -> String {
 }
 
 /// Evaluates every WAV with a Praat reference under `dir`, and the prompts' syllable counts.
-pub fn evaluate(dir: &Path) -> Result<Report, CliError> {
+pub fn evaluate(dir: &Path) -> Result<Report, SimError> {
     let mut wavs = Vec::new();
     wav_files(dir, &mut wavs)?;
     let ref_dir = dir.join("reference").join("praat");
@@ -142,7 +142,7 @@ pub fn evaluate(dir: &Path) -> Result<Report, CliError> {
             continue;
         }
         let reference =
-            eval::parse_track_csv(&read_text(&ref_path)?).map_err(|source| CliError::Data {
+            eval::parse_track_csv(&read_text(&ref_path)?).map_err(|source| SimError::Data {
                 path: ref_path.clone(),
                 source,
             })?;
@@ -159,7 +159,7 @@ pub fn evaluate(dir: &Path) -> Result<Report, CliError> {
     let mut syllables = Vec::new();
     if prompts_path.is_file() {
         let prompts =
-            eval::parse_prompts(&read_text(&prompts_path)?).map_err(|source| CliError::Data {
+            eval::parse_prompts(&read_text(&prompts_path)?).map_err(|source| SimError::Data {
                 path: prompts_path.clone(),
                 source,
             })?;
@@ -348,7 +348,7 @@ pub fn to_json(r: &Report) -> Value {
 }
 
 /// Runs the subcommand: resolve the folder, evaluate, print.
-pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(), CliError> {
+pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(), SimError> {
     let dir = match resolve_data_dir(data) {
         DataDir::Found(d) => d,
         DataDir::Missing(tried) => {

@@ -1,7 +1,7 @@
 //! # host-sim
 //!
 //! The desktop simulator: audio files in, exactly the runtime's computations out, so that what
-//! a user sees on the desktop is what the board will do (DESIGN.md, "Who uses it"). `std`;
+//! a user sees on the desktop is what the board will do (docs/method.md, "Who uses it"). `std`;
 //! nothing here re-implements runtime behaviour: prosody comes from
 //! [`gesture_trainer::features::prosody_of`], which calls the runtime front-end.
 //!
@@ -10,13 +10,15 @@
 //! - [`cli`]: the `gesture-sim` command line, exit codes and error lines.
 //! - [`prosody_cmd`]: `gesture-sim prosody`: per-frame or per-syllable CSV of a WAV file.
 //! - [`eval`]: pure comparison functions (reference CSV parsing, frame matching, the metrics
-//!   of `shared/tools/prosody_compare.py`, syllable counts).
+//!   of the Praat comparison: voicing, gross and fine pitch error, intensity correlation;
+//!   syllable counts).
 //! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
 //! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
-//! - [`run`](mod@run): `gesture-sim run`: a WAV file through the runtime's `Controller`, with
+//! - [`run`](mod@run): `gesture-sim run`: a WAV file through the runtime's device loop, with
 //!   BVH, timeline, servo trace and previews written to a folder.
 //! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
 //!   [`live::AudioSource`] trait, with a fake source for tests.
+//! - [`error`]: [`error::SimError`], the error of every command, and its exit status.
 //! - [`demo`]: `gesture-sim demo`: synth, fit, pack, a new utterance and `run`, in one command.
 //! - [`servo`]: virtual PWM pins under the runtime's `ServoRig`.
 #![forbid(unsafe_code)]
@@ -25,6 +27,7 @@
 pub mod bench;
 pub mod cli;
 pub mod demo;
+pub mod error;
 pub mod eval;
 pub mod eval_cmd;
 pub mod live;

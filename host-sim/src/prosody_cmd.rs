@@ -1,7 +1,6 @@
 //! `gesture-sim prosody`: a WAV file's prosody as CSV, exactly as the runtime computes it.
 //!
-//! Formats (also those of `shared/data/reference/praat/*.csv`, so the two can be compared
-//! with `shared/tools/prosody_compare.py`):
+//! Formats (those of the Praat reference CSVs, so the two can be compared line by line):
 //!
 //! - frames: `time_s,f0_hz,intensity_db`, time with 4 decimals, F0 and intensity with 2, F0
 //!   empty when unvoiced;
@@ -16,7 +15,7 @@ use std::path::Path;
 use gesture_runtime::prosody::{Frame, ProsodyConfig, Step, StepKind};
 use gesture_trainer::{audio, features};
 
-use crate::cli::CliError;
+use crate::error::SimError;
 
 /// Header of the per-frame CSV.
 pub const FRAME_HEADER: &str = "time_s,f0_hz,intensity_db";
@@ -51,7 +50,7 @@ pub fn write_syllables_csv(out: &mut impl Write, steps: &[Step]) -> io::Result<(
 
 /// Loads `wav` at the default front-end rate, runs the front-end and writes the frame CSV (or
 /// the syllable CSV when `syllables`) to `out`.
-pub fn run(wav: &Path, syllables: bool, out: &mut impl Write) -> Result<(), CliError> {
+pub fn run(wav: &Path, syllables: bool, out: &mut impl Write) -> Result<(), SimError> {
     let config = ProsodyConfig::DEFAULT;
     let pcm = audio::load_wav_at(wav, config.sample_rate_hz)?;
     let (frames, steps) = features::prosody_of(&pcm.samples, &config)?;

@@ -221,7 +221,7 @@ fn eval_on_shared_data_when_present() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     if v["measured"] == false {
-        eprintln!("skipped: {}", v["reason"]);
+        e2e_tests::skip("eval_on_shared_data_when_present", &v["reason"].to_string());
         return;
     }
     let data = PathBuf::from(v["data"].as_str().unwrap());

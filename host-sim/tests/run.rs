@@ -422,13 +422,9 @@ fn puppet_channels_read_back_from_the_rebuilt_frames() {
 }
 
 fn shared_data() -> Option<PathBuf> {
-    let d = workspace().join("../shared/data");
-    if d.is_dir() {
-        Some(d)
-    } else {
-        eprintln!("skipping: {} absent", d.display());
-        None
-    }
+    e2e_tests::shared_data("run_on_the_shared_recordings", "zeroeggs-067-speech2")
+        .and_then(|_| e2e_tests::shared_data("run_on_the_shared_recordings", "beat-scott"))
+        .map(|_| e2e_tests::shared_data_dir())
 }
 
 #[test]
@@ -448,7 +444,7 @@ fn run_on_the_shared_recordings() {
         .iter()
         .find(|p| p.extension().is_some_and(|e| e == "wav"));
     let (Some(bvh), Some(wav)) = (bvh, wav) else {
-        eprintln!("skipping: no ZeroEGGS take");
+        e2e_tests::skip("run_on_the_shared_recordings", "no ZeroEGGS take");
         return;
     };
     let blob = s.root.join("zeggs.blob");
@@ -466,7 +462,10 @@ fn run_on_the_shared_recordings() {
     let beat = data.join("beat-scott/2_scott_0_1_1.wav");
     for (name, audio) in [("beat", beat), ("zeggs", wav.clone())] {
         if !audio.is_file() {
-            eprintln!("skipping {}: absent", audio.display());
+            e2e_tests::skip(
+                "run_on_the_shared_recordings",
+                &format!("{} is absent", audio.display()),
+            );
             continue;
         }
         let out = s.root.join(format!("out-{name}"));

@@ -1,5 +1,5 @@
 //! The `Controller`: microphone samples in; at every animation tick a pose out; decisions at
-//! exit points from the current belief (DESIGN.md "The runtime").
+//! exit points from the current belief (docs/method.md "The runtime").
 //!
 //! Per sample the prosody front-end runs; each finished step (syllable or pause) is
 //! normalized, turned into cluster memberships and fed to the CRF forward step. Animation ticks

@@ -3,12 +3,13 @@
 //! The part of the gesture controller that runs on the board: microphone samples in, a belief
 //! over gesture-style states per syllable, a gesture choice at each segment exit, and poses and
 //! servo duty cycles out (Levine et al., *Gesture Controllers*, SIGGRAPH 2010; the design is
-//! restated in `DESIGN.md`).
+//! restated in `docs/method.md`).
 //!
 //! ## Contract
 //!
 //! - `#![no_std]`, no `alloc`: every buffer has a compile-time capacity and every state type has
-//!   a size known at compile time.
+//!   a size known at compile time. (The blob *writer*, for host tools, needs `alloc` and is
+//!   behind the `encode` feature; a firmware never enables it.)
 //! - No panics on any input: arbitrary samples (silence, clipping, DC) and, once loaded, arbitrary
 //!   blob bytes give correct output or a typed error. Outputs are always finite.
 //! - Deterministic: `f32` arithmetic with `libm`, so the same input gives the same decisions on
@@ -23,14 +24,19 @@
 //!   and pause steps during silence.
 //! - [`inference`]: speaker-normalized step features, prosody-cluster memberships and the CRF
 //!   forward step: the belief over hidden gesture-style states.
-//! - [`blob`]: the policy blob (header, CRC-32, postcard payload), validated once at load into
-//!   a typed error; accessors are infallible afterwards.
+//! - [`blob`]: the policy blob format (header, CRC-32, postcard payload): the reader, validated
+//!   once at load into a typed error (accessors are infallible afterwards), and, with the
+//!   `encode` feature, the writer and its quantizer.
 //! - [`policy`]: the choice of the next segment at an exit point from the belief.
 //! - [`player`]: segment playback as rig poses with a short blend at cuts.
 //! - [`controller`]: samples in, poses out: front-end, belief, decisions and playback on one
-//!   sample clock.
+//!   sample clock; built from a validated blob.
+//! - [`device`]: the one device loop: a blob's controller and its servo rig, samples in, poses,
+//!   duty cycles and events out; what boards, the simulator and evaluations run.
 //! - [`rig`]: servo calibration and the `ServoRig`: pose angles to clamped, slew-limited PWM
 //!   duty cycles through `embedded_hal::pwm::SetDutyCycle`; neutral pose on fault.
+//! - [`rotation`]: rotation matrices, quaternions and Euler angles in `f32` or `f64`, shared by
+//!   the device and the host tools.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

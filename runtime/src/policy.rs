@@ -1,4 +1,4 @@
-//! Choosing the next gesture segment at an exit point (DESIGN.md "MDP" and "It factorizes").
+//! Choosing the next gesture segment at an exit point (docs/method.md "MDP" and "It factorizes").
 //!
 //! With belief `b` at exit point `e`, each allowed successor `c` costs `S(e, c) + b . U(c)`
 //! and continuing the current segment (interruption exits only) costs `b . U_cont(e)`; the

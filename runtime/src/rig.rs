@@ -1,5 +1,5 @@
 //! The servo rig: pose angles in, PWM duty cycles out, through
-//! [`embedded_hal::pwm::SetDutyCycle`] (DESIGN.md, "The runtime").
+//! [`embedded_hal::pwm::SetDutyCycle`] (docs/method.md, "The runtime").
 //!
 //! Owns the per-channel calibration ([`ChannelCal`]), its validation, and [`ServoRig`], which
 //! clamps each target angle to the channel's limits, limits how fast it may change (slew) and

@@ -14,15 +14,15 @@ use gesture_trainer::corpus::{load_corpus, LoadOptions};
 use gesture_trainer::inference::train::{fit, prosody_point, sequences, FitConfig};
 use gesture_trainer::pack::{pack_model, PackOptions};
 
-fn data() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    d.join("beat-scott").is_dir().then_some(d)
+fn data(test: &str) -> Option<PathBuf> {
+    e2e_tests::shared_data(test, "beat-scott")?;
+    e2e_tests::shared_data(test, "zeroeggs-067-speech2")?;
+    Some(e2e_tests::shared_data_dir())
 }
 
 #[test]
 fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
-    let Some(d) = data() else {
-        eprintln!("skipping: ../shared/data is absent, nothing measured");
+    let Some(d) = data("runtime_decisions_agree_with_the_float_policy_on_another_speaker") else {
         return;
     };
     // Model and library from the ZeroEGGS take.
@@ -124,15 +124,14 @@ struct EvalCli {
     args: gesture_trainer::cli::eval_motion::EvalMotionArgs,
 }
 
-/// The pack issue's motion-quality requirement, with the command-line defaults: a model fitted
+/// The motion-quality requirement of the control layer, with the command-line defaults: a model fitted
 /// on ZeroEGGS 0-40 s, the take's own library, the device's online controller (quantized,
 /// decisions on syllable onsets) against random selection from the same library, on held-out
 /// speech: ZeroEGGS 40-50 s and both beat-scott monologues (another speaker).
 #[test]
 fn online_controller_beats_random_on_jumps_and_beat_alignment_on_held_out_speech() {
     use clap::Parser;
-    let Some(d) = data() else {
-        eprintln!("skipping: ../shared/data is absent, nothing measured");
+    let Some(d) = data("online_controller_beats_random_on_jumps_and_beat_alignment") else {
         return;
     };
     let ze = d.join("zeroeggs-067-speech2");

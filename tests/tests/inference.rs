@@ -12,10 +12,8 @@ use gesture_trainer::inference::train::{
 };
 use gesture_trainer::synth::{write_corpus, SynthParams};
 
-fn zeroeggs() -> Option<PathBuf> {
-    let d =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/zeroeggs-067-speech2");
-    d.is_dir().then_some(d)
+fn zeroeggs(test: &str) -> Option<PathBuf> {
+    e2e_tests::shared_data(test, "zeroeggs-067-speech2")
 }
 
 /// Runs the runtime's fixed-memory path (normalizer is already applied in the features) and
@@ -45,8 +43,7 @@ fn l1_per_step(model: &InferenceModel, seq: &Sequence) -> Vec<f64> {
 
 #[test]
 fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
-    let Some(dir) = zeroeggs() else {
-        eprintln!("skipping: ../shared/data is absent, nothing measured");
+    let Some(dir) = zeroeggs("runtime_belief_matches_float_on_every_step_of_the_real_take") else {
         return;
     };
     let corpus = load_corpus(&[dir], &LoadOptions::default()).unwrap();
@@ -208,8 +205,8 @@ fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
 
 #[test]
 fn fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window() {
-    let Some(dir) = zeroeggs() else {
-        eprintln!("skipping: ../shared/data is absent, nothing measured");
+    let Some(dir) = zeroeggs("fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window")
+    else {
         return;
     };
     let d = dir.to_str().unwrap();

@@ -1,18 +1,16 @@
-//! The prosody front-end against Praat on every real recording in `../shared/data` (issue
-//! "Workspace, CI, and the streaming prosody front-end"): the thresholds the project promises.
-//! Skips, saying so, when the data folder is absent.
+//! The prosody front-end against Praat on every real recording in `../shared/data`: the
+//! thresholds the project promises. Skips, saying so, when the data folder is absent.
 
 use std::path::PathBuf;
 
-fn data_dir() -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    d.join("reference/praat").is_dir().then_some(d)
+fn data_dir(test: &str) -> Option<PathBuf> {
+    e2e_tests::shared_data(test, "reference/praat").map(|_| e2e_tests::shared_data_dir())
 }
 
 #[test]
 fn every_file_meets_the_praat_thresholds() {
-    let Some(dir) = data_dir() else {
-        eprintln!("skipping: ../shared/data is absent, nothing measured");
+    const TEST: &str = "every_file_meets_the_praat_thresholds";
+    let Some(dir) = data_dir(TEST) else {
         return;
     };
     let report = host_sim::eval_cmd::evaluate(&dir).expect("evaluation runs");
@@ -51,8 +49,8 @@ fn every_file_meets_the_praat_thresholds() {
 
 #[test]
 fn cmu_arctic_syllable_total_within_15_percent() {
-    let Some(dir) = data_dir() else {
-        eprintln!("skipping: ../shared/data is absent, nothing measured");
+    const TEST: &str = "cmu_arctic_syllable_total_within_15_percent";
+    let Some(dir) = data_dir(TEST) else {
         return;
     };
     let report = host_sim::eval_cmd::evaluate(&dir).expect("evaluation runs");

@@ -3,7 +3,7 @@
 //! This is the one place host code computes prosody: [`prosody_of`] feeds samples to
 //! [`gesture_runtime::prosody::FrontEnd`] and collects what it reports. Nothing here
 //! re-implements pitch, intensity or syllable detection, so training features and device
-//! features cannot drift apart (DESIGN.md, "Workspace").
+//! features cannot drift apart (docs/method.md, "Workspace").
 //!
 //! Allocates the two output vectors; never panics.
 

@@ -11,13 +11,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 fn data_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: real data not found at {}", dir.display());
-        None
-    }
+    e2e_tests::shared_data("motion_real", "")
 }
 
 fn zeroeggs(dir: &Path) -> PathBuf {

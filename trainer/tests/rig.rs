@@ -18,13 +18,7 @@ fn puppet() -> Rig {
 }
 
 fn data_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: real data not found at {}", dir.display());
-        None
-    }
+    e2e_tests::shared_data("rig", "")
 }
 
 const SHOULDERS: [&str; 4] = [

@@ -319,7 +319,7 @@ pub fn write_all(dir: &Path, files: &[(&'static str, Vec<u8>)]) -> Result<Vec<Pa
 }
 
 /// Runs the command; the summary goes to `out`.
-pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::cli::CliError> {
+pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::SimError> {
     let total = Instant::now();
     // Inputs first: nothing is written unless all of them are usable.
     if cfg.out.exists() && !cfg.out.is_dir() {

@@ -167,8 +167,10 @@ impl fmt::Display for Field {
     }
 }
 
-/// Why [`Blob::parse`](super::Blob::parse) refused the bytes. Checks run in the order of the
-/// variants below (docs/blob-format.md, "Validation"), and the first failure is reported.
+/// Why [`Blob::parse`](super::Blob::parse) refused the bytes. Checks run in the order of
+/// docs/blob-format.md, section 4 (header, decoding, then section by section), and the first
+/// failure is reported; the variants below are grouped by phase and section, not in check
+/// order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BlobError {
     // --- header ---

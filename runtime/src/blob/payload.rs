@@ -168,7 +168,7 @@ pub struct InferenceSection<'a> {
     pub crf_obs: I16Section<'a>,
 }
 
-/// The control layer in factorized form (DESIGN.md, "It factorizes; store it that way").
+/// The control layer in factorized form (docs/method.md, "It factorizes; store it that way").
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PolicySection<'a> {
     /// Hidden states S (equals the inference section's).

@@ -1,5 +1,5 @@
 //! The optional host-side `skeleton` section, read: the library's BVH joint tree, its rest
-//! pose, and which joint rotation each rig channel drives (docs/blob-format.md, 3.6).
+//! pose, and which joint rotation each rig channel drives (docs/blob-format.md, 3.7).
 //!
 //! The device never needs it: the controller plays rig channel values. Host tools (the
 //! simulator's BVH output and previews) use it to put those values back on the skeleton. Like
@@ -222,7 +222,7 @@ impl<'a> SkeletonView<'a> {
         self.s.channel_codes.len()
     }
 
-    /// Joint `j`'s channels as indices into the frame (and [`Self::channel_code`],
+    /// Joint `j`'s channels as indices into the frame (and [`Self::channel`],
     /// [`Self::rest`]); empty out of range. O(j).
     pub fn joint_channels(&self, j: usize) -> core::ops::Range<usize> {
         let counts = self.s.channel_counts;

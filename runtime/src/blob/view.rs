@@ -224,12 +224,12 @@ impl<'a> Blob<'a> {
 
     // --- policy ---
 
-    /// Library segments (1..=[`MAX_SEGMENTS`]).
+    /// Library segments (1..=[`MAX_SEGMENTS`](super::MAX_SEGMENTS)).
     pub fn segments(&self) -> usize {
         self.payload.policy.segments as usize
     }
 
-    /// Exit points (1..=[`MAX_EXITS`]).
+    /// Exit points (1..=[`MAX_EXITS`](super::MAX_EXITS)).
     pub fn exit_points(&self) -> usize {
         self.payload.policy.exit_points as usize
     }
@@ -355,7 +355,7 @@ impl<'a> Blob<'a> {
 
     // --- library ---
 
-    /// Output channels (1..=[`MAX_CHANNELS`]).
+    /// Output channels (1..=[`MAX_CHANNELS`](super::MAX_CHANNELS)).
     pub fn channels(&self) -> usize {
         self.payload.library.channels as usize
     }
@@ -365,7 +365,7 @@ impl<'a> Blob<'a> {
         self.payload.library.fps
     }
 
-    /// Frames in the frame table (1..=[`MAX_FRAMES`]).
+    /// Frames in the frame table (1..=[`MAX_FRAMES`](super::MAX_FRAMES)).
     pub fn frames(&self) -> usize {
         self.payload.library.frames as usize
     }

@@ -1,6 +1,6 @@
 //! The inference layer on the device: prosody features of each step, their memberships in the
 //! prosody clusters (the GMM), and one CRF forward step per syllable giving the belief over the
-//! hidden gesture-style states (DESIGN.md, inference layer step 4).
+//! hidden gesture-style states (docs/method.md, inference layer step 4).
 //!
 //! Parameters arrive from the blob: the GMM as a few `f32` per cluster, the CRF weights as
 //! little-endian `i16` tables with one `f32` scale each ([`I16Table`]), read on access so they can

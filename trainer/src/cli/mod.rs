@@ -186,19 +186,6 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// A progress bar on stderr (hidden when stderr is not a terminal); the style every command
-/// of both binaries uses.
-pub fn progress_bar(len: u64, what: &str) -> indicatif::ProgressBar {
-    let pb = indicatif::ProgressBar::new(len);
-    pb.set_style(
-        indicatif::ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len} ({elapsed})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_message(what.to_string());
-    pb
-}
-
 /// Checks that an output folder can be created.
 pub(crate) fn ensure_dir(dir: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(dir)

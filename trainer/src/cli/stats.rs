@@ -6,9 +6,10 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::args::CorpusArgs;
-use super::{progress_bar, CliError};
+use super::CliError;
 use crate::corpus::discover;
 use crate::corpus::stats::{take_stats, TakeStats};
+use crate::progress::progress_bar;
 
 /// Arguments of `corpus-stats`.
 #[derive(Debug, clap::Args)]

@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{ensure_dir, progress_bar, CliError};
+use super::{ensure_dir, CliError};
+use crate::progress::progress_bar;
 use crate::synth::{write_corpus, SynthParams};
 
 /// Arguments of `synth`.

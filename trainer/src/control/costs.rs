@@ -1,4 +1,4 @@
-//! Costs of the control layer (DESIGN.md, "Control layer"): how well a segment fits each hidden
+//! Costs of the control layer (docs/method.md, "Control layer"): how well a segment fits each hidden
 //! state (`psi`), and how well one segment follows another (successor costs).
 //!
 //! - `psi_a(i) = E_{y ~ N(mu_i, Sigma_i)} ||y - y_a||`, by Monte Carlo with the same 512

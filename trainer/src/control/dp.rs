@@ -1,4 +1,4 @@
-//! The offline reference (DESIGN.md "Offline reference"): with the whole utterance known, the
+//! The offline reference (docs/method.md "Offline reference"): with the whole utterance known, the
 //! best sequence of segments by dynamic programming over time, using the forward-backward
 //! state posteriors (which see the future) instead of the online belief.
 //!

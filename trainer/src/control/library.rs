@@ -1,5 +1,5 @@
 //! The gesture library: motion segments with their kinematic vectors, recorded order, exit
-//! points and the pose features the transition costs need (DESIGN.md, control layer).
+//! points and the pose features the transition costs need (docs/method.md, control layer).
 //!
 //! A library comes from any BVH files (the training takes or another character): each take is
 //! segmented like the corpus ([`crate::motion::analyze`]) and each segment gets its normalized

@@ -1,4 +1,4 @@
-//! The control MDP and value iteration (DESIGN.md "MDP" and "It factorizes; store it that
+//! The control MDP and value iteration (docs/method.md "MDP" and "It factorizes; store it that
 //! way"; the paper's section 7 and appendix).
 //!
 //! Decisions happen at exit points. At exit point `e` of segment `a`, in hidden state `s`, the

@@ -1,4 +1,4 @@
-//! The control layer (DESIGN.md "Control layer", the paper's section 7 and appendix): from a
+//! The control layer (docs/method.md "Control layer", the paper's section 7 and appendix): from a
 //! belief over hidden states, which gesture segment to show next.
 //!
 //! - [`library`]: segments, recorded order, exit points, pose features;

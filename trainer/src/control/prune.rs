@@ -1,4 +1,4 @@
-//! Pruning the successor lists (DESIGN.md "Pruning"; the paper removed ~98% of entries).
+//! Pruning the successor lists (docs/method.md "Pruning"; the paper removed ~98% of entries).
 //!
 //! At exit `e`, candidate `c` costs `C_c(s) = S(e, c) + U(c, s)` in state `s`. If another
 //! candidate (or continuing, `U_cont(e, s)`) costs no more in *every* state, `c` can never be

@@ -1,7 +1,7 @@
-//! Motion quality of a controller on held-out audio, against references (the pack issue's
-//! "motion quality" report): the online policy (decisions from the causal belief), random
-//! selection from the same library, the offline dynamic-programming sequence (posteriors that
-//! see the whole utterance), and, where the audio has its own motion capture, the real motion.
+//! Motion quality of a controller on held-out audio, against references: the online policy
+//! (decisions from the causal belief), random selection from the same library, the offline
+//! dynamic-programming sequence (posteriors that see the whole utterance), and, where the
+//! audio has its own motion capture, the real motion.
 //!
 //! The online sequence is what the device plays (`crate::evaluate::motion`): the packed
 //! blob's bytes through the runtime's device loop, fed the audio's samples, with its decision

@@ -1,6 +1,6 @@
 //! Speech-motion alignment: the runtime front-end's steps (syllables and pause steps), each with
 //! its normalized prosody features and the time-weighted kinematic target of the motion it
-//! overlaps (DESIGN.md, "Time step = syllable (or pause step)").
+//! overlaps (docs/method.md, "Time step = syllable (or pause step)").
 //!
 //! The target of step `[a, b)` is `sum_s w_s y_s / sum_s w_s` over the motion segments `s` it
 //! overlaps, `w_s` the overlap in seconds and `y_s` the segment's log-scale kinematic vector.

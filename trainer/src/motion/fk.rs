@@ -28,7 +28,7 @@
 //!
 //! ## Invariants
 //!
-//! Nothing here panics on a valid [`Motion`] (every `Motion` is valid, see [`super::bvh`]);
+//! Nothing here panics on a valid [`Motion`] (every `Motion` is valid, see [`super::skeleton`]);
 //! target indices are checked once when an [`FkPlan`] is built and the skeleton is checked
 //! against the motion's when it is run. Results are finite for finite input.
 

@@ -1,7 +1,7 @@
 //! Segmentation of a take into gesture phases by end-effector speed.
 //!
 //! Owns the per-frame speed signal and the cut rule. Segments are cut where the mean effector
-//! speed crosses a threshold (DESIGN.md, "Data and time steps"): fast segments are strokes or
+//! speed crosses a threshold (docs/method.md, "Data and time steps"): fast segments are strokes or
 //! retractions, slow ones holds and rests.
 //!
 //! ## The signal

@@ -87,7 +87,7 @@
 //! [`gesture_runtime::rig::validate_period`], so a runtime `ServoRig` built from it cannot
 //! refuse it. A [`BoundRig`] holds joint indices valid for the skeleton it was bound to;
 //! [`BoundRig::channel_values`] gives `None` rather than panicking for another skeleton or a
-//! frame out of range, and finite values for a valid [`Motion`].
+//! frame out of range, and finite values for a valid [`Motion`](crate::motion::Motion).
 
 mod bind;
 mod file;
