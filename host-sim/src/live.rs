@@ -30,8 +30,7 @@ use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::StepKind;
 use gesture_runtime::rig::MAX_CHANNELS;
-use rubato::audioadapter_buffers::direct::SequentialSliceOfSlices;
-use rubato::{Async, FixedAsync, Resampler, SincInterpolationParameters, WindowFunction};
+use gesture_trainer::audio::{to_i16, StreamResampler};
 
 /// Why the live path failed.
 #[derive(Debug, thiserror::Error)]
@@ -135,75 +134,6 @@ impl AudioSource for FakeSource {
     }
 }
 
-/// Streaming resampler to the blob's rate (identity when the rates match).
-pub struct StreamResampler {
-    inner: Option<Async<f32>>,
-    pending: Vec<f32>,
-}
-
-impl StreamResampler {
-    /// From `from` Hz to `to` Hz.
-    pub fn new(from: u32, to: u32) -> Result<Self, LiveError> {
-        if from == to {
-            return Ok(Self {
-                inner: None,
-                pending: Vec::new(),
-            });
-        }
-        let err = |reason: String| LiveError::Resample { from, to, reason };
-        if from == 0 || to == 0 {
-            return Err(err("a rate is 0".into()));
-        }
-        let params = SincInterpolationParameters::new(128, WindowFunction::BlackmanHarris2)
-            .oversampling_factor(128);
-        let chunk = (from as usize / 100).max(16);
-        let r = Async::<f32>::new_sinc(
-            to as f64 / from as f64,
-            1.0,
-            &params,
-            chunk,
-            1,
-            FixedAsync::Input,
-        )
-        .map_err(|e| err(e.to_string()))?;
-        Ok(Self {
-            inner: Some(r),
-            pending: Vec::new(),
-        })
-    }
-
-    /// Feeds `input`; appends every output sample ready so far to `out`.
-    pub fn push(&mut self, input: &[f32], out: &mut Vec<f32>) -> Result<(), LiveError> {
-        let Some(r) = &mut self.inner else {
-            out.extend_from_slice(input);
-            return Ok(());
-        };
-        self.pending.extend_from_slice(input);
-        loop {
-            let need = r.input_frames_next();
-            if self.pending.len() < need {
-                return Ok(());
-            }
-            let chans = [&self.pending[..need]];
-            let adapter = SequentialSliceOfSlices::new(&chans, 1, need)
-                .map_err(|e| LiveError::Backend(e.to_string()))?;
-            let o = r
-                .process(&adapter, None)
-                .map_err(|e| LiveError::Backend(e.to_string()))?;
-            out.extend(o.take_data());
-            self.pending.drain(..need);
-        }
-    }
-}
-
-/// Full scale +-1 to `i16` (round, clamp, non-finite to 0), as the WAV loader does.
-pub fn to_i16(x: f32) -> i16 {
-    if !x.is_finite() {
-        return 0;
-    }
-    (x * 32768.0).round().clamp(-32768.0, 32767.0) as i16
-}
-
 /// A one-line picture of a belief: one block character per state, then the top state.
 pub fn belief_bar(b: &[f32]) -> String {
     const BLOCKS: [char; 8] = ['▁', '▂', '▃', '▄', '▅', '▆', '▇', '█'];
@@ -256,7 +186,13 @@ pub fn live_loop(
     let mut device: Device<'_, '_, NullPin, MAX_CHANNELS> =
         Device::new(controller, [NullPin; MAX_CHANNELS])
             .map_err(|e| LiveError::Backend(format!("device: {e}")))?;
-    let mut resampler = StreamResampler::new(source.rate_hz(), rate)?;
+    let (from, to) = (source.rate_hz(), rate);
+    let resample_err = |e: gesture_trainer::audio::ConvertError| LiveError::Resample {
+        from,
+        to,
+        reason: e.to_string(),
+    };
+    let mut resampler = StreamResampler::new(from, to).map_err(resample_err)?;
     let fps = blob.fps() as f64;
     let limit = opts.seconds.map(|s| (s * rate as f64).round() as u64);
     let mut stats = LiveStats::default();
@@ -277,7 +213,7 @@ pub fn live_loop(
         raw.clear();
         let more = source.read(&mut raw, Duration::from_millis(200))?;
         resampled.clear();
-        resampler.push(&raw, &mut resampled)?;
+        resampler.push(&raw, &mut resampled).map_err(resample_err)?;
         pcm.clear();
         pcm.extend(resampled.iter().map(|&x| to_i16(x)));
         if let Some(l) = limit {

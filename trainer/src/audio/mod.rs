@@ -36,8 +36,11 @@ use std::io::{self, Cursor};
 use std::path::{Path, PathBuf};
 
 use hound::{SampleFormat, WavReader};
-use rubato::audioadapter_buffers::direct::SequentialSliceOfSlices;
-use rubato::{Async, FixedAsync, Resampler, SincInterpolationParameters, WindowFunction};
+
+mod resample;
+
+use resample::resample;
+pub use resample::StreamResampler;
 
 /// Lowest accepted file (and target) sample rate in Hz.
 pub const MIN_RATE_HZ: u32 = 8_000;
@@ -45,13 +48,6 @@ pub const MIN_RATE_HZ: u32 = 8_000;
 pub const MAX_RATE_HZ: u32 = 48_000;
 /// The default target rate: the front-end's default rate.
 pub const DEFAULT_TARGET_RATE_HZ: u32 = gesture_runtime::prosody::DEFAULT_RATE_HZ;
-
-/// Sinc filter length of the resampler (taps).
-const SINC_LEN: usize = 256;
-/// Sinc tables per input sample period (rubato's default).
-const OVERSAMPLING: usize = 128;
-/// Input frames per resampler call.
-const CHUNK: usize = 1024;
 
 /// How samples are stored in a WAV file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -277,51 +273,13 @@ fn finite_or_zero(x: f32) -> f32 {
     }
 }
 
-/// Full scale ±1 to `i16`: round to nearest, clamp, non-finite to 0.
-fn to_i16(x: f32) -> i16 {
+/// Full scale ±1 to `i16`: round to nearest, clamp, non-finite to 0 (the one conversion of
+/// every audio path: WAV files and the live microphone).
+pub fn to_i16(x: f32) -> i16 {
     if !x.is_finite() {
         return 0;
     }
     (x * 32768.0).round().clamp(-32768.0, 32767.0) as i16
-}
-
-/// Band-limited resampling of a whole clip with the delay trimmed and the length set to
-/// [`converted_len`]. Rates are already validated.
-///
-/// Delay: rubato computes output frame `j` (before trimming) from the sinc kernel centred on
-/// input time `(j + 1) / ratio - L / 2 + 1 / OVERSAMPLING` (`L` = [`SINC_LEN`]), so its true
-/// delay is `ratio * (L / 2 - 1 / OVERSAMPLING) - 1` output frames, usually fractional.
-/// `process_all` trims `floor(ratio * L / 2)` frames, which leaves events up to ~1 frame early;
-/// we trim or pad the difference, rounded, so the residual is at most half an output frame.
-/// The impulse test pins this for every rate we accept, so a rubato change that moves the
-/// kernel fails loudly.
-fn resample(samples: &[f32], from_hz: u32, to_hz: u32) -> Result<Vec<f32>, ConvertError> {
-    let out_len = converted_len(samples.len(), from_hz, to_hz);
-    if samples.is_empty() {
-        return Ok(Vec::new());
-    }
-    let err = |e: &dyn std::error::Error| ConvertError::Resampler(e.to_string());
-    let ratio = to_hz as f64 / from_hz as f64;
-    let params = SincInterpolationParameters::new(SINC_LEN, WindowFunction::BlackmanHarris2)
-        .oversampling_factor(OVERSAMPLING);
-    let mut resampler = Async::<f32>::new_sinc(ratio, 1.0, &params, CHUNK, 1, FixedAsync::Input)
-        .map_err(|e| err(&e))?;
-    let channels = [samples];
-    let input = SequentialSliceOfSlices::new(&channels, 1, samples.len()).map_err(|e| err(&e))?;
-    let exact_delay = ratio * (SINC_LEN as f64 / 2.0 - 1.0 / OVERSAMPLING as f64) - 1.0;
-    let correction = (exact_delay - resampler.output_delay() as f64).round() as isize;
-    // `process_all` returns ceil(len * ratio) frames after trimming `output_delay()`.
-    let out = resampler
-        .process_all(&input, samples.len(), None)
-        .map_err(|e| err(&e))?;
-    let mut data = out.take_data();
-    if correction > 0 {
-        data.drain(..(correction as usize).min(data.len()));
-    } else if correction < 0 {
-        data.splice(0..0, std::iter::repeat_n(0.0, correction.unsigned_abs()));
-    }
-    data.resize(out_len, 0.0);
-    Ok(data)
 }
 
 /// Reads the header with hound, validates rate and format, and mixes the samples to mono `f32`.
