@@ -56,6 +56,49 @@ pub fn write_atomic_with(
     Ok(())
 }
 
+/// Writes `files` (name, bytes) into `dir` (created if needed) all or nothing: every file first
+/// to its own temporary sibling, then all renamed. On a failure the temporaries are removed and
+/// the targets renamed so far are deleted, so no partial set of outputs is left. Returns the
+/// paths written.
+pub fn write_all_atomic(
+    dir: &Path,
+    files: &[(&str, Vec<u8>)],
+) -> Result<Vec<PathBuf>, OutputError> {
+    let err = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| OutputError {
+            path,
+            source: plain(source),
+        }
+    };
+    std::fs::create_dir_all(dir).map_err(err(dir))?;
+    let mut temps = Vec::with_capacity(files.len());
+    for (name, bytes) in files {
+        let target = dir.join(name);
+        let mut tmp = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(".tmp")
+            .tempfile_in(dir)
+            .map_err(err(&target))?;
+        tmp.as_file_mut()
+            .write_all(bytes)
+            .and_then(|()| tmp.as_file().sync_all())
+            .map_err(err(&target))?;
+        temps.push((tmp, target));
+    }
+    let mut done: Vec<PathBuf> = Vec::with_capacity(temps.len());
+    for (tmp, target) in temps {
+        if let Err(e) = tmp.persist(&target) {
+            for d in &done {
+                let _ = std::fs::remove_file(d);
+            }
+            return Err(err(&target)(e.error));
+        }
+        done.push(target);
+    }
+    Ok(done)
+}
+
 /// The operating system's error without the temporary file's path (which `tempfile` appends
 /// as " at path ..."): messages name the target only.
 fn plain(e: std::io::Error) -> std::io::Error {
@@ -90,6 +133,24 @@ mod tests {
         assert!(e.to_string().starts_with(&p.display().to_string()), "{e}");
         assert_eq!(std::fs::read(&p).unwrap(), b"old");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_set_of_files_is_written_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("run");
+        let files = [("a.txt", b"a".to_vec()), ("b.txt", b"bb".to_vec())];
+        let written = write_all_atomic(&out, &files).unwrap();
+        assert_eq!(written.len(), 2);
+        assert_eq!(std::fs::read(out.join("b.txt")).unwrap(), b"bb");
+        assert_eq!(std::fs::read_dir(&out).unwrap().count(), 2);
+        // A name that cannot be a file (a folder is in the way): nothing new is left.
+        std::fs::create_dir(out.join("c.txt")).unwrap();
+        let files = [("d.txt", b"d".to_vec()), ("c.txt", b"c".to_vec())];
+        let e = write_all_atomic(&out, &files).unwrap_err();
+        assert!(e.to_string().contains("c.txt"), "{e}");
+        assert!(!out.join("d.txt").exists());
+        assert_eq!(std::fs::read_dir(&out).unwrap().count(), 3);
     }
 
     #[test]

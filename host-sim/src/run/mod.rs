@@ -275,47 +275,13 @@ pub fn render(
     Ok(Outputs { files, bvh_frames })
 }
 
-/// Writes `files` into `dir` (created if needed): every file first to a temporary sibling,
-/// then all renamed. On failure the temporaries are removed and no output file is left.
+/// Writes `files` into `dir` (created if needed), all or nothing
+/// ([`gesture_trainer::output::write_all_atomic`]).
 pub fn write_all(dir: &Path, files: &[(&'static str, Vec<u8>)]) -> Result<Vec<PathBuf>, RunError> {
-    let werr = |path: &Path| {
-        let path = path.to_owned();
-        move |source| RunError::Write { path, source }
-    };
-    std::fs::create_dir_all(dir).map_err(werr(dir))?;
-    let pid = std::process::id();
-    let mut temps: Vec<(PathBuf, PathBuf)> = Vec::new();
-    let cleanup = |temps: &[(PathBuf, PathBuf)]| {
-        for (t, _) in temps {
-            let _ = std::fs::remove_file(t);
-        }
-    };
-    for (name, bytes) in files {
-        let target = dir.join(name);
-        let tmp = dir.join(format!(".{name}.tmp{pid}"));
-        let res = (|| {
-            let mut f = std::fs::File::create(&tmp)?;
-            f.write_all(bytes)?;
-            f.sync_all()
-        })();
-        temps.push((tmp.clone(), target));
-        if let Err(e) = res {
-            cleanup(&temps);
-            return Err(werr(&tmp)(e));
-        }
-    }
-    let mut done = Vec::new();
-    for (i, (tmp, target)) in temps.iter().enumerate() {
-        if let Err(e) = std::fs::rename(tmp, target) {
-            cleanup(&temps[i..]);
-            for d in &done {
-                let _ = std::fs::remove_file(d);
-            }
-            return Err(werr(target)(e));
-        }
-        done.push(target.clone());
-    }
-    Ok(done)
+    gesture_trainer::output::write_all_atomic(dir, files).map_err(|e| RunError::Write {
+        path: e.path,
+        source: e.source,
+    })
 }
 
 /// Runs the command; the summary goes to `out`.
