@@ -13,12 +13,20 @@
 //! against the speech, so that new gestures start with syllables: an interruption exit is only
 //! decided at when a syllable onset was detected within the last `onset_window_ms` (otherwise
 //! the segment plays on, as if the policy had chosen to continue), and at a segment's end the
-//! player holds the last frame until an onset arrives, for at most `max_wait_ms`, before
-//! deciding. [`DecisionTiming::IMMEDIATE`] decides at every exit point as soon as it is
-//! reached (the paper's controller). Onsets come from the front-end ([`Event::Onset`]).
+//! controller waits for an onset, for at most `max_wait_ms`, before deciding. **The body never
+//! stops while it waits**: the player runs on into the segment's recorded successor (the
+//! frames that followed it in the capture); choosing that successor then simply continues it,
+//! and choosing anything else cuts from where the body is. A segment without a recorded
+//! successor (the end of a clip) does not wait: it decides at once. [`DecisionTiming::IMMEDIATE`]
+//! decides at every exit point as soon as it is reached (the paper's controller). Onsets come
+//! from the front-end ([`Event::Onset`]).
 //!
-//! Memory is fixed: the front-end (about 9 KiB), a belief, the player and a few counters.
-//! Nothing allocates or panics; poses are finite.
+//! **Variety.** Every segment entry goes into a fixed-capacity history, from which each
+//! decision charges recently entered and much-used candidates ([`Variety`], see
+//! [`crate::policy`]). Cuts are inertialized by the player ([`crate::player`]).
+//!
+//! Memory is fixed: the front-end (about 9 KiB), a belief, the player, the history and a few
+//! counters. Nothing allocates or panics; poses are finite.
 //!
 //! Building: [`Controller::new`] returns the controller (about 15 KiB) by value, which the
 //! compiler copies through stack temporaries on its way; [`Controller::new_in`] builds the same
@@ -31,7 +39,7 @@ use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
 use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
-use crate::policy::{select, Choice, Decision, PolicyTables};
+use crate::policy::{select, Choice, Decision, History, Penalties, PolicyTables, Variety, Visit};
 use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
 
 /// When the controller decides at exit points (see the module docs).
@@ -155,6 +163,9 @@ impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
             blob,
         )?;
         me.timing = blob.timing();
+        me.variety = blob.variety();
+        let blend = me.ms_ticks(blob.blend_ms());
+        me.player.set_blend_ticks(blend);
         Ok(me)
     }
 }
@@ -178,9 +189,15 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     samples: u64,
     ticks: u64,
     timing: DecisionTiming,
+    variety: Variety,
+    history: History,
+    /// Belief the policy decides with instead of the CRF's (an evaluation's ablation).
+    held: Option<[f32; MAX_STATES]>,
     /// Tick at which the last onset was detected (the tick due next when it arrived).
     last_onset: Option<u64>,
-    /// Ticks held at the current end exit, waiting for an onset.
+    /// The end exit the controller is waiting at for an onset, running on meanwhile.
+    waiting: Option<usize>,
+    /// Ticks waited at it.
     waited: u64,
 }
 
@@ -229,7 +246,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             samples: 0,
             ticks: 0,
             timing: DecisionTiming::DEFAULT,
+            variety: Variety::NONE,
+            history: History::new(),
+            held: None,
             last_onset: None,
+            waiting: None,
             waited: 0,
         });
         if let Err(e) = me.front_end.configure(config) {
@@ -276,6 +297,28 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         } else {
             self.belief.probs(s)
         }
+    }
+
+    /// Makes every decision use `belief` (one value per state) instead of the CRF's, or the
+    /// CRF's again with `None`. The belief still evolves and is reported; only the choice
+    /// ignores it. For evaluations (the "belief held at the prior" ablation); a `belief` of
+    /// another length is ignored.
+    pub fn hold_belief(&mut self, belief: Option<&[f32]>) {
+        self.held = belief.filter(|b| b.len() == self.tables.states()).map(|b| {
+            let mut h = [0.0; MAX_STATES];
+            h[..b.len()].copy_from_slice(b);
+            h
+        });
+    }
+
+    /// Sets how decisions vary (the default is the blob's).
+    pub fn set_variety(&mut self, variety: Variety) {
+        self.variety = variety;
+    }
+
+    /// How decisions vary.
+    pub fn variety(&self) -> Variety {
+        self.variety
     }
 
     /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
@@ -370,52 +413,115 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         }
     }
 
+    /// Ticks in `ms` milliseconds (rounded up).
+    fn ms_ticks(&self, ms: u32) -> u32 {
+        let t = (ms as u64 * self.fps_milli).div_ceil(1_000_000);
+        t.min(u32::MAX as u64) as u32
+    }
+
     fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
         let segment = self.player.segment();
         let played = self.player.tick(self.lib, &mut self.pose);
         let tick = self.ticks;
         self.ticks += 1;
+        if self.ticks == 1 {
+            self.history.write(Visit {
+                segment: segment.min(u16::MAX as usize) as u16,
+                tick: 0,
+            });
+        }
         sink(ControllerEvent::Pose {
             tick,
             pose: &self.pose[..self.lib.channels().min(MAX_CHANNELS)],
             segment,
             frame: played,
         });
-        let e = self.exit;
-        if self.tables.exit_segment(e) == segment && played >= self.tables.exit_frame(e) {
-            let t = self.timing;
-            let fresh = !t.sync_to_onsets
-                || self.last_onset.is_some_and(|o| {
-                    !self.ticks_reach_ms(tick.saturating_sub(o), t.onset_window_ms)
-                });
-            if !fresh {
-                if !self.tables.exit_is_end(e) {
-                    // No onset now: play on past this interruption frame.
-                    if e + 1 < self.tables.exit_count() {
-                        self.exit = e + 1;
-                    }
-                    return;
-                }
-                if !self.ticks_reach_ms(self.waited, t.max_wait_ms) {
-                    // Hold the segment's last frame until an onset (or the wait runs out).
-                    self.waited += 1;
-                    return;
-                }
+        let t = self.timing;
+        let fresh = !t.sync_to_onsets
+            || self
+                .last_onset
+                .is_some_and(|o| !self.ticks_reach_ms(tick.saturating_sub(o), t.onset_window_ms));
+        if let Some(e) = self.waiting {
+            // Running on into the successor while waiting for an onset.
+            if fresh
+                || self.ticks_reach_ms(self.waited, t.max_wait_ms)
+                || self.player.at_end(self.lib)
+            {
+                self.waiting = None;
+                self.waited = 0;
+                self.decide(e, tick, sink);
+            } else {
+                self.waited += 1;
             }
-            self.waited = 0;
-            let decision = select(self.tables, e, self.belief());
-            match decision.choice {
-                Choice::Continue => {
-                    if e + 1 < self.tables.exit_count() {
-                        self.exit = e + 1;
-                    }
-                }
-                Choice::Enter(c) => {
-                    self.player.enter(c);
-                    self.exit = self.tables.first_exit(c);
-                }
-            }
-            sink(ControllerEvent::Decision { tick, decision });
+            return;
         }
+        let e = self.exit;
+        if self.tables.exit_segment(e) != segment || played < self.tables.exit_frame(e) {
+            return;
+        }
+        if !fresh {
+            if !self.tables.exit_is_end(e) {
+                // No onset now: play on past this interruption frame.
+                if e + 1 < self.tables.exit_count() {
+                    self.exit = e + 1;
+                }
+                return;
+            }
+            if t.max_wait_ms > 0 && self.lib.continues(segment) {
+                // Wait for an onset, the body moving on into the recorded successor.
+                self.player.run_on(self.lib);
+                self.waiting = Some(e);
+                self.waited = 1;
+                return;
+            }
+        }
+        self.decide(e, tick, sink);
+    }
+
+    /// Decides at exit `e` and acts on it.
+    fn decide(&mut self, e: usize, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        let now = tick.min(u32::MAX as u64) as u32;
+        let penalties = Penalties::new(
+            &self.variety,
+            &self.history,
+            now,
+            self.ms_ticks(self.variety.recency_ms),
+            self.ms_ticks(self.variety.usage_ms),
+        );
+        let s = self.tables.states();
+        let decision = match &self.held {
+            Some(h) => select(self.tables, e, &h[..s], &penalties),
+            None => select(self.tables, e, self.belief(), &penalties),
+        };
+        match decision.choice {
+            Choice::Continue => {
+                if e + 1 < self.tables.exit_count() {
+                    self.exit = e + 1;
+                }
+            }
+            Choice::Enter(c) => {
+                // The player ran on into the recorded successor while waiting: choosing it
+                // goes on without a cut; anything else (or no run-on) is a cut.
+                let ran_on = self.player.segment() != self.tables.exit_segment(e);
+                if !(ran_on && c == self.player.segment()) {
+                    self.player.enter(self.lib, c);
+                }
+                self.history.write(Visit {
+                    segment: c.min(u16::MAX as usize) as u16,
+                    tick: now,
+                });
+                // The first exit point not yet passed.
+                let mut x = self.tables.first_exit(c);
+                let frame = self.player.frame();
+                while !self.tables.exit_is_end(x)
+                    && self.tables.exit_frame(x) < frame
+                    && x + 1 < self.tables.exit_count()
+                {
+                    x += 1;
+                }
+                self.exit = x;
+            }
+        }
+        sink(ControllerEvent::Decision { tick, decision });
     }
 }

@@ -1,14 +1,42 @@
-//! Playing library segments as rig poses, one frame per animation tick, with a short linear
-//! blend at cuts so a jump between segments becomes a quick move instead of a snap.
+//! Playing library segments as rig poses, one frame per animation tick, with seamless cuts.
 //!
-//! Invariants: fixed memory ([`MAX_CHANNELS`] values of state), no allocation, no panics;
+//! **Inertialization at every cut** (and self-loop). Switching segments leaves the pose where
+//! it was; the new segment's frames are played from their first frame, and the difference
+//! (the *offset*: last pose shown minus the new segment's first frame, and its velocity) is
+//! added on top and decays to zero over the blend time with a critically damped spring:
+//! `x(n) = (x0 + (v0 + a x0) n) e^(-a n)` for tick `n` after the cut, `a = 6.64 / blend_ticks`
+//! (1 % left at the end, where the offset is dropped). The pose and its velocity are
+//! continuous across the cut, and after the blend the library's frames come back exactly.
+//! Unlike a crossfade, the new motion starts at once (its stroke is not delayed), and unlike a
+//! linear blend, no frame jumps.
+//!
+//! Channels are blended as what they are:
+//! - a single angle (a servo, a twist, one Euler angle of a puppet): offset in degrees, linear
+//!   (a servo's 170 and -170 degrees are far apart, not neighbours);
+//! - a **rotation group** (three channels holding one joint's rotation as Euler angles in a
+//!   given order, as the full-skeleton rig stores BVH joints): the offset is a rotation
+//!   (`q_out = exp(x) q_frame`, `x` a rotation vector), so the blend is quaternion-correct
+//!   whatever the Euler angles do, and the output angles are the decomposition closest to the
+//!   frame's own (no 360-degree flips).
+//!
+//! **Running on.** [`Player::run_on`] moves from a segment's last frame into the segment stored
+//! after it (its recorded successor) without a cut, so the body keeps moving while the
+//! controller waits for a syllable onset.
+//!
+//! Invariants: fixed memory (a few arrays of [`MAX_CHANNELS`] values), no allocation, no panics;
 //! every output value is finite (non-finite library values are replaced by the previous
-//! output).
+//! output, non-finite offsets by none).
+
+use crate::rotation::{
+    euler_angles, euler_matrix, quat_conj, quat_exp, quat_log, quat_matrix, quat_mul, quaternion,
+    wrap_deg,
+};
 
 /// Most rig channels a pose can have.
 pub const MAX_CHANNELS: usize = crate::rig::MAX_CHANNELS;
-/// Frames over which a cut is blended.
-pub const BLEND_FRAMES: usize = 3;
+
+/// Decay of a critically damped spring over the blend: `a * blend_ticks` (1 % left).
+const SETTLE: f32 = 6.64;
 
 /// The library's frames as the player needs them. Built only from validated data: indices
 /// passed in are always in range.
@@ -23,28 +51,61 @@ pub trait LibraryFrames {
     fn segment_len(&self, c: usize) -> usize;
     /// Value of channel `ch` at frame `f` of segment `c` (degrees).
     fn value(&self, c: usize, f: usize, ch: usize) -> f32;
+    /// Whether segment `c + 1` continues segment `c` (its recorded successor, played on into
+    /// while waiting).
+    fn continues(&self, _c: usize) -> bool {
+        false
+    }
+    /// Rotation groups (three channels holding one rotation as Euler angles).
+    fn group_count(&self) -> usize {
+        0
+    }
+    /// Group `g`: first channel and Euler order (axis indices).
+    fn group(&self, _g: usize) -> (usize, [u8; 3]) {
+        (usize::MAX, [0, 1, 2])
+    }
 }
 
-/// Segment playback with blending.
+/// Segment playback with inertialized cuts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Player {
     segment: usize,
     frame: usize,
     last: [f32; MAX_CHANNELS],
-    blend_from: [f32; MAX_CHANNELS],
-    blend_left: usize,
+    prev: [f32; MAX_CHANNELS],
+    outputs: u32,
+    /// Offset at the cut: degrees per channel, or a rotation vector (radians) in a group's
+    /// three slots.
+    off: [f32; MAX_CHANNELS],
+    /// Offset velocity at the cut, per tick.
+    vel: [f32; MAX_CHANNELS],
+    /// Ticks since the cut (blending while below `blend_ticks`).
+    since: u32,
+    blend_ticks: u32,
+    blending: bool,
 }
 
 impl Player {
-    /// At frame 0 of segment 0, all channels at 0 until the first frame is played.
+    /// At frame 0 of segment 0, all channels at 0 until the first frame is played; cuts are
+    /// hard until [`set_blend_ticks`](Self::set_blend_ticks).
     pub const fn new() -> Self {
         Self {
             segment: 0,
             frame: 0,
             last: [0.0; MAX_CHANNELS],
-            blend_from: [0.0; MAX_CHANNELS],
-            blend_left: 0,
+            prev: [0.0; MAX_CHANNELS],
+            outputs: 0,
+            off: [0.0; MAX_CHANNELS],
+            vel: [0.0; MAX_CHANNELS],
+            since: 0,
+            blend_ticks: 0,
+            blending: false,
         }
+    }
+
+    /// Cuts blend over `ticks` animation ticks (0: hard cuts).
+    pub fn set_blend_ticks(&mut self, ticks: u32) {
+        self.blend_ticks = ticks;
     }
 
     /// Current segment.
@@ -57,12 +118,101 @@ impl Player {
         self.frame
     }
 
-    /// Cuts to segment `c` at its first frame, blending from the last output pose.
-    pub fn enter(&mut self, c: usize) {
+    /// Whether the last frame of the segment has been played (the next tick holds it).
+    pub fn at_end<L: LibraryFrames + ?Sized>(&self, lib: &L) -> bool {
+        self.frame + 1 >= lib.segment_len(self.segment).max(1) && self.outputs > 0
+    }
+
+    /// Moves on into segment `segment + 1` at its first frame without a cut (it must be the
+    /// recorded successor: [`LibraryFrames::continues`]); a blend in progress goes on.
+    pub fn run_on<L: LibraryFrames + ?Sized>(&mut self, lib: &L) {
+        if lib.continues(self.segment) && self.segment + 1 < lib.segment_count() {
+            self.segment += 1;
+            self.frame = 0;
+        }
+    }
+
+    /// Cuts to segment `c` at its first frame, inertializing from the last output pose.
+    pub fn enter<L: LibraryFrames + ?Sized>(&mut self, lib: &L, c: usize) {
+        self.enter_at(lib, c, 0);
+    }
+
+    /// Cuts to segment `c` at frame `f` (clamped into the segment), inertializing from the
+    /// last output pose.
+    pub fn enter_at<L: LibraryFrames + ?Sized>(&mut self, lib: &L, c: usize, f: usize) {
+        let len = lib.segment_len(c).max(1);
+        let f = f.min(len - 1);
         self.segment = c;
-        self.frame = 0;
-        self.blend_from = self.last;
-        self.blend_left = BLEND_FRAMES;
+        self.frame = f;
+        self.since = 0;
+        self.blending = self.blend_ticks > 0 && self.outputs > 0;
+        if !self.blending {
+            return;
+        }
+        let n = lib.channels().min(MAX_CHANNELS);
+        let moving = self.outputs > 1;
+        let next = (f + 1).min(len - 1);
+        // The offset is taken at the time of the last output, one tick before the new
+        // segment's first frame shows: against that frame extrapolated one tick back.
+        for ch in 0..n {
+            let t0 = self.target(lib, c, f, ch);
+            let t1 = self.target(lib, c, next, ch);
+            let x0 = self.last[ch] - (t0 - (t1 - t0));
+            let src_v = if moving {
+                self.last[ch] - self.prev[ch]
+            } else {
+                0.0
+            };
+            let v0 = src_v - (t1 - t0);
+            self.off[ch] = if x0.is_finite() { x0 } else { 0.0 };
+            self.vel[ch] = if v0.is_finite() { v0 } else { 0.0 };
+        }
+        for g in 0..lib.group_count() {
+            let (first, order) = lib.group(g);
+            if first.saturating_add(3) > n {
+                continue;
+            }
+            let o = [order[0] as usize, order[1] as usize, order[2] as usize];
+            let q = |v: [f32; 3]| quaternion(&euler_matrix(o, v));
+            let angles = |src: &[f32; MAX_CHANNELS]| [src[first], src[first + 1], src[first + 2]];
+            let frame_angles = |fr: usize| {
+                [
+                    self.target(lib, c, fr, first),
+                    self.target(lib, c, fr, first + 1),
+                    self.target(lib, c, fr, first + 2),
+                ]
+            };
+            let (q_last, q_t0, q_t1) = (
+                q(angles(&self.last)),
+                q(frame_angles(f)),
+                q(frame_angles(next)),
+            );
+            let w_t = quat_log(&quat_mul(&q_t1, &quat_conj(&q_t0)));
+            let back = quat_mul(&quat_exp(&[-w_t[0], -w_t[1], -w_t[2]]), &q_t0);
+            let x0 = quat_log(&quat_mul(&q_last, &quat_conj(&back)));
+            let w_s = if moving {
+                let q_prev = q(angles(&self.prev));
+                quat_log(&quat_mul(&q_last, &quat_conj(&q_prev)))
+            } else {
+                [0.0; 3]
+            };
+            for k in 0..3 {
+                let v0 = w_s[k] - w_t[k];
+                self.off[first + k] = if x0[k].is_finite() { x0[k] } else { 0.0 };
+                self.vel[first + k] = if v0.is_finite() { v0 } else { 0.0 };
+            }
+        }
+    }
+
+    /// The library value of channel `ch` at frame `f` of segment `c`, or the last output if
+    /// it is not finite.
+    fn target<L: LibraryFrames + ?Sized>(&self, lib: &L, c: usize, f: usize, ch: usize) -> f32 {
+        let v = lib.value(c, f, ch);
+        if v.is_finite() {
+            v
+        } else {
+            self.last[ch]
+        }
     }
 
     /// Plays the current frame into `out[..channels]`, then advances one frame (holding the
@@ -75,22 +225,52 @@ impl Player {
         let n = lib.channels().min(MAX_CHANNELS);
         let len = lib.segment_len(self.segment).max(1);
         let f = self.frame.min(len - 1);
-        let alpha = if self.blend_left > 0 {
-            let k = BLEND_FRAMES - self.blend_left;
-            self.blend_left -= 1;
-            (k + 1) as f32 / (BLEND_FRAMES + 1) as f32
-        } else {
-            1.0
-        };
+        let c = self.segment;
         for (ch, o) in out.iter_mut().enumerate().take(n) {
-            let v = lib.value(self.segment, f, ch);
-            let v = if v.is_finite() { v } else { self.last[ch] };
-            *o = self.blend_from[ch] + alpha * (v - self.blend_from[ch]);
-            if alpha >= 1.0 {
-                *o = v;
+            *o = self.target(lib, c, f, ch);
+        }
+        if self.blending && self.since >= self.blend_ticks {
+            self.blending = false;
+        }
+        if self.blending {
+            let a = SETTLE / self.blend_ticks as f32;
+            // Tick 1 is the first frame of the new segment (the offset is from tick 0).
+            let t = (self.since + 1) as f32;
+            let decay = libm::expf(-a * t);
+            let spring = |x0: f32, v0: f32| (x0 + (v0 + a * x0) * t) * decay;
+            for (ch, o) in out.iter_mut().enumerate().take(n) {
+                *o += spring(self.off[ch], self.vel[ch]);
             }
+            for g in 0..lib.group_count() {
+                let (first, order) = lib.group(g);
+                if first.saturating_add(3) > n {
+                    continue;
+                }
+                let o = [order[0] as usize, order[1] as usize, order[2] as usize];
+                let frame = [
+                    self.target(lib, c, f, first),
+                    self.target(lib, c, f, first + 1),
+                    self.target(lib, c, f, first + 2),
+                ];
+                let x = [
+                    spring(self.off[first], self.vel[first]),
+                    spring(self.off[first + 1], self.vel[first + 1]),
+                    spring(self.off[first + 2], self.vel[first + 2]),
+                ];
+                let q = quat_mul(&quat_exp(&x), &quaternion(&euler_matrix(o, frame)));
+                let angles = nearest_euler(euler_angles(&quat_matrix(&q), o), frame, o);
+                out[first..first + 3].copy_from_slice(&angles);
+            }
+            self.since += 1;
+        }
+        for (ch, o) in out.iter_mut().enumerate().take(n) {
+            if !o.is_finite() {
+                *o = self.last[ch];
+            }
+            self.prev[ch] = self.last[ch];
             self.last[ch] = *o;
         }
+        self.outputs = self.outputs.saturating_add(1);
         if self.frame + 1 < len {
             self.frame += 1;
         }
@@ -98,8 +278,179 @@ impl Player {
     }
 }
 
+/// Of the two Euler decompositions of one rotation (`(a, b, c)` and
+/// `(a + 180, 180 - b, c + 180)`, wrapped), the one closer to `near`, each angle then moved by
+/// whole turns to lie within 180 degrees of `near`'s.
+fn nearest_euler(angles: [f32; 3], near: [f32; 3], order: [usize; 3]) -> [f32; 3] {
+    // The second solution's middle angle: 180 - b for cyclic orders (b = asin(+-m)), which is
+    // the same rotation because R_i(a + 180) R_j(180 - b) R_k(c + 180) = R_i(a) R_j(b) R_k(c).
+    let _ = order;
+    let alt = [angles[0] + 180.0, 180.0 - angles[1], angles[2] + 180.0];
+    let close = |v: [f32; 3]| {
+        let mut w = [0.0f32; 3];
+        let mut d = 0.0f32;
+        for k in 0..3 {
+            w[k] = near[k] + wrap_deg(v[k] - near[k]);
+            d += (w[k] - near[k]).abs();
+        }
+        (w, d)
+    };
+    let (a, da) = close(angles);
+    let (b, db) = close(alt);
+    if db < da {
+        b
+    } else {
+        a
+    }
+}
+
 impl Default for Player {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two segments on two single-angle channels and one rotation group.
+    struct Lib {
+        groups: bool,
+    }
+
+    impl LibraryFrames for Lib {
+        fn channels(&self) -> usize {
+            5
+        }
+        fn fps(&self) -> f32 {
+            30.0
+        }
+        fn segment_count(&self) -> usize {
+            2
+        }
+        fn segment_len(&self, _: usize) -> usize {
+            20
+        }
+        fn value(&self, c: usize, f: usize, ch: usize) -> f32 {
+            let f = f as f32;
+            match (c, ch) {
+                (0, 0) => 10.0 + f,
+                (1, 0) => -40.0 + 0.5 * f,
+                (0, 1) => 170.0,
+                (1, 1) => -170.0,
+                // Group channels (Z, Y, X): segment 0 turns about Z, segment 1 rests at a
+                // tilt about X.
+                (0, 2) => 2.0 * f,
+                (1, 4) => 60.0,
+                _ => 0.0,
+            }
+        }
+        fn group_count(&self) -> usize {
+            self.groups as usize
+        }
+        fn group(&self, _: usize) -> (usize, [u8; 3]) {
+            (2, [2, 1, 0])
+        }
+    }
+
+    fn run(p: &mut Player, lib: &Lib, ticks: usize) -> [f32; MAX_CHANNELS] {
+        let mut out = [0.0; MAX_CHANNELS];
+        for _ in 0..ticks {
+            p.tick(lib, &mut out);
+        }
+        out
+    }
+
+    #[test]
+    fn a_hard_cut_plays_the_new_frames_at_once() {
+        let lib = Lib { groups: false };
+        let mut p = Player::new();
+        run(&mut p, &lib, 5);
+        p.enter(&lib, 1);
+        let out = run(&mut p, &lib, 1);
+        assert_eq!(out[0], -40.0);
+    }
+
+    #[test]
+    fn an_inertialized_cut_moves_like_the_spring_and_ends_exactly_on_the_frames() {
+        let lib = Lib { groups: false };
+        let mut p = Player::new();
+        p.set_blend_ticks(9);
+        run(&mut p, &lib, 5); // channel 0 at 14, moving +1 per tick
+        p.enter(&lib, 1);
+        // Offset against segment 1's first frame extrapolated one tick back: 14 - (-40.5).
+        let (x0, v0, a) = (54.5f32, 0.5f32, SETTLE / 9.0);
+        let mut out = [0.0; MAX_CHANNELS];
+        let mut prev = 14.0f32;
+        for k in 1..=12u32 {
+            p.tick(&lib, &mut out);
+            let t = k as f32;
+            let spring = if k <= 9 {
+                (x0 + (v0 + a * x0) * t) * libm::expf(-a * t)
+            } else {
+                0.0
+            };
+            let frame = -40.0 + 0.5 * (k - 1) as f32;
+            assert!(
+                (out[0] - (frame + spring)).abs() < 1e-3,
+                "tick {k}: {}",
+                out[0]
+            );
+            // No step is larger than the spring's largest speed (x0 a / e) plus the frames'.
+            assert!((out[0] - prev).abs() <= x0 * a / core::f32::consts::E + 1.0);
+            prev = out[0];
+        }
+        // After the blend, the library's frames exactly (frame 11 of segment 1).
+        assert_eq!(out[0], -40.0 + 0.5 * 11.0);
+        // A servo angle blends linearly: from 170 to -170 through 0, and arrives exactly.
+        assert_eq!(out[1], -170.0);
+    }
+
+    #[test]
+    fn a_rotation_group_blends_as_a_rotation() {
+        let lib = Lib { groups: true };
+        let mut p = Player::new();
+        p.set_blend_ticks(9);
+        run(&mut p, &lib, 10); // Z = 18 deg, turning 2 deg per tick
+        p.enter(&lib, 1);
+        let mut out = run(&mut p, &lib, 1);
+        // First frame after the cut: the old rotation carried on (Z ~ 20, X ~ 0).
+        let rot = |o: &[f32; MAX_CHANNELS]| euler_matrix([2, 1, 0], [o[2], o[3], o[4]]);
+        let angle = |a: &[f32; 4], b: &[f32; 4]| {
+            let d: f32 = (0..4).map(|k| a[k] * b[k]).sum();
+            2.0 * libm::acosf(d.abs().min(1.0)) * 57.2958
+        };
+        // The first frame after the cut has moved from the last pose (Z = 18) by the spring's
+        // first step only: (1 - (1 + a) e^-a) of the 61-degree offset, about 10 degrees.
+        let q0 = quaternion(&rot(&out));
+        let last = quaternion(&euler_matrix([2usize, 1, 0], [18.0f32, 0.0, 0.0]));
+        let a = SETTLE / 9.0;
+        let first = 1.0 - (1.0 + a) * libm::expf(-a);
+        assert!(angle(&q0, &last) < first * 61.0 + 3.0, "{:?}", &out[2..5]);
+        // The rotation turns toward the target (60 degrees away) in steps no larger than the
+        // spring allows (about 60 * a / e per tick), never a snap.
+        let mut prev = q0;
+        for _ in 0..12 {
+            out = run(&mut p, &lib, 1);
+            let q = quaternion(&rot(&out));
+            let step = angle(&q, &prev);
+            assert!(step < 20.0, "step {step}");
+            prev = q;
+        }
+        // Blend over: exactly the frame (X = 60).
+        assert_eq!([out[2], out[3], out[4]], [0.0, 0.0, 60.0]);
+    }
+
+    #[test]
+    fn nearest_euler_prefers_the_solution_close_to_the_frame() {
+        // Z=170, Y=100 (past 90), X=10 decomposes canonically with |Y| <= 90.
+        let m = euler_matrix([2usize, 1, 0], [170.0f32, 100.0, 10.0]);
+        let canon = euler_angles(&m, [2, 1, 0]);
+        assert!(canon[1] <= 90.0);
+        let near = nearest_euler(canon, [170.0, 100.0, 10.0], [2, 1, 0]);
+        for (a, b) in near.iter().zip([170.0, 100.0, 10.0]) {
+            assert!((a - b).abs() < 1e-2, "{near:?}");
+        }
     }
 }

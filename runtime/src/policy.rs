@@ -1,4 +1,5 @@
-//! Choosing the next gesture segment at an exit point (docs/method.md "MDP" and "It factorizes").
+//! Choosing the next gesture segment at an exit point (docs/method.md "MDP" and "It
+//! factorizes"), with costs for variety.
 //!
 //! With belief `b` at exit point `e`, each allowed successor `c` costs `S(e, c) + b . U(c)`
 //! and continuing the current segment (interruption exits only) costs `b . U_cont(e)`; the
@@ -6,8 +7,27 @@
 //! sorted by segment index), exactly as the trainer's float policy decides, so host and
 //! device agree whenever the quantized costs keep the same order.
 //!
+//! **Variety** (docs/method.md, "Beyond the paper"). The value tables are optimal for the
+//! paper's cost, which has no memory: with a small library and a weak belief the pure policy
+//! settles on the few segments that are cheapest on average and loops them. Motion-matching
+//! practice adds a cost for what was just shown; so does this selector, at selection time, from
+//! a fixed-capacity [`History`] of the last [`HISTORY`] segment entries:
+//!
+//! - **recency**: `recency_cost * (1 - age / recency)` for a candidate entered `age < recency`
+//!   ago (a repeat within seconds reads as a loop);
+//! - **usage**: `usage_cost * share` where `share` is the candidate's share of the frames
+//!   played in the last `usage` window (no segment should dominate the minute).
+//!
+//! Both are added to the candidates' costs (never to continuing: playing on is not a repeat);
+//! the value tables are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
+//! cost of variety against the pure policy (its regret) is measured by
+//! `gesture-train eval-motion`. All arithmetic is on integer ticks and the same `f32`
+//! operations on host and device, so both choose alike.
+//!
 //! The tables come from a validated blob through [`PolicyTables`]; every index the selector
 //! uses was range-checked at load, so nothing here can panic.
+
+use heapless::HistoryBuffer;
 
 /// The policy tables as the selector needs them. Implementations must only be built from
 /// validated data: every method is called with indices in range.
@@ -50,10 +70,124 @@ pub struct Decision {
     pub exit: usize,
     /// What was chosen.
     pub choice: Choice,
-    /// Its expected cost under the belief.
+    /// Its expected cost under the belief, variety costs included.
     pub cost: f32,
     /// Candidates considered (successors plus continuing where allowed).
     pub candidates: usize,
+}
+
+/// Variety costs (see the module docs); all zero: the paper's decision rule.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Variety {
+    /// Cost of a candidate entered just now (cost units), falling linearly to 0 at
+    /// `recency_ms`.
+    pub recency_cost: f32,
+    /// Recency window (ms).
+    pub recency_ms: u32,
+    /// Cost per unit of a candidate's share of the frames played in the last `usage_ms`.
+    pub usage_cost: f32,
+    /// Usage window (ms).
+    pub usage_ms: u32,
+}
+
+impl Variety {
+    /// No variety costs: the pure policy.
+    pub const NONE: Self = Self {
+        recency_cost: 0.0,
+        recency_ms: 0,
+        usage_cost: 0.0,
+        usage_ms: 0,
+    };
+}
+
+/// Segment entries the controller remembers.
+pub const HISTORY: usize = 32;
+
+/// One segment entry: the segment and the tick it was entered at.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Visit {
+    /// Segment entered.
+    pub segment: u16,
+    /// Animation tick of the entry.
+    pub tick: u32,
+}
+
+/// The last [`HISTORY`] segment entries, oldest first (fixed memory).
+pub type History = HistoryBuffer<Visit, HISTORY>;
+
+/// The variety cost of every recently visited segment at one decision, computed once from the
+/// history (at most [`HISTORY`] distinct segments; any other segment costs nothing).
+#[derive(Clone, Copy, Debug)]
+pub struct Penalties {
+    segment: [u16; HISTORY],
+    cost: [f32; HISTORY],
+    len: usize,
+}
+
+impl Penalties {
+    /// No penalties.
+    pub const NONE: Self = Self {
+        segment: [0; HISTORY],
+        cost: [0.0; HISTORY],
+        len: 0,
+    };
+
+    /// The penalties at tick `now` given `history` and the windows in ticks (`recency_ticks`,
+    /// `usage_ticks`; 0 disables a term).
+    pub fn new(
+        v: &Variety,
+        history: &History,
+        now: u32,
+        recency_ticks: u32,
+        usage_ticks: u32,
+    ) -> Self {
+        let mut p = Self::NONE;
+        if v.recency_cost <= 0.0 && v.usage_cost <= 0.0 {
+            return p;
+        }
+        let window_start = now.saturating_sub(usage_ticks);
+        // Newest first: the first visit of a segment met is its latest entry.
+        let mut end = now;
+        let (older, newer) = history.as_slices();
+        for visit in newer.iter().rev().chain(older.iter().rev()) {
+            let k = match p.segment[..p.len].iter().position(|&s| s == visit.segment) {
+                Some(k) => k,
+                None => {
+                    if p.len == HISTORY {
+                        break;
+                    }
+                    p.segment[p.len] = visit.segment;
+                    p.cost[p.len] = 0.0;
+                    p.len += 1;
+                    let k = p.len - 1;
+                    let age = now.saturating_sub(visit.tick);
+                    if recency_ticks > 0 && age < recency_ticks {
+                        let left = 1.0 - age as f32 / recency_ticks as f32;
+                        p.cost[k] += v.recency_cost * left;
+                    }
+                    k
+                }
+            };
+            if usage_ticks > 0 && end > window_start {
+                let played = end - visit.tick.max(window_start);
+                p.cost[k] += v.usage_cost * played as f32 / usage_ticks as f32;
+            }
+            end = visit.tick;
+            if end <= window_start && visit.tick.saturating_add(recency_ticks) <= now {
+                // Older visits can no longer add anything.
+                break;
+            }
+        }
+        p
+    }
+
+    /// The penalty of segment `c`.
+    pub fn of(&self, c: usize) -> f32 {
+        self.segment[..self.len]
+            .iter()
+            .position(|&s| s as usize == c)
+            .map_or(0.0, |k| self.cost[k])
+    }
 }
 
 fn dot<T: PolicyTables + ?Sized>(t: &T, b: &[f32], f: impl Fn(&T, usize) -> f32) -> f32 {
@@ -64,10 +198,16 @@ fn dot<T: PolicyTables + ?Sized>(t: &T, b: &[f32], f: impl Fn(&T, usize) -> f32)
     acc
 }
 
-/// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries). At an
-/// end exit with no successor (a blob whose pruning left none) the choice falls back to
-/// entering segment 0, so playback never stalls.
-pub fn select<T: PolicyTables + ?Sized>(t: &T, e: usize, b: &[f32]) -> Decision {
+/// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries), each
+/// candidate segment `c` charged `penalty.of(c)` on top. At an end exit with no successor (a
+/// blob whose pruning left none) the choice falls back to entering segment 0, so playback
+/// never stalls.
+pub fn select<T: PolicyTables + ?Sized>(
+    t: &T,
+    e: usize,
+    b: &[f32],
+    penalty: &Penalties,
+) -> Decision {
     let mut best = Decision {
         exit: e,
         choice: Choice::Continue,
@@ -80,7 +220,7 @@ pub fn select<T: PolicyTables + ?Sized>(t: &T, e: usize, b: &[f32]) -> Decision 
     }
     for k in 0..t.successor_count(e) {
         let (c, sc) = t.successor(e, k);
-        let v = sc + dot(t, b, |t, s| t.u(c, s));
+        let v = sc + dot(t, b, |t, s| t.u(c, s)) + penalty.of(c);
         best.candidates += 1;
         if v < best.cost {
             best.cost = v;
@@ -91,4 +231,99 @@ pub fn select<T: PolicyTables + ?Sized>(t: &T, e: usize, b: &[f32]) -> Decision 
         best.choice = Choice::Enter(0);
     }
     best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn history(visits: &[(u16, u32)]) -> History {
+        let mut h = History::new();
+        for &(segment, tick) in visits {
+            h.write(Visit { segment, tick });
+        }
+        h
+    }
+
+    #[test]
+    fn recency_falls_linearly_and_usage_counts_frames_in_the_window() {
+        let v = Variety {
+            recency_cost: 2.0,
+            recency_ms: 0,
+            usage_cost: 10.0,
+            usage_ms: 0,
+        };
+        // Segment 3 entered at tick 0, segment 5 at 60, segment 3 again at 80; now 100.
+        let h = history(&[(3, 0), (5, 60), (3, 80)]);
+        let p = Penalties::new(&v, &h, 100, 50, 100);
+        // Recency of 3: age 20 of 50 -> 2 * 0.6; usage: 60 + 20 frames of 100.
+        assert!((p.of(3) - (1.2 + 10.0 * 0.8)).abs() < 1e-5, "{}", p.of(3));
+        // 5: age 40 -> 2 * 0.2; 20 frames.
+        assert!((p.of(5) - (0.4 + 10.0 * 0.2)).abs() < 1e-5, "{}", p.of(5));
+        assert_eq!(p.of(7), 0.0);
+        // A usage window of 30 ticks: only 3 (ticks 80..100) and 5 (70..80) count.
+        let p = Penalties::new(&v, &h, 100, 0, 30);
+        assert!((p.of(3) - 10.0 * 20.0 / 30.0).abs() < 1e-5);
+        assert!((p.of(5) - 10.0 * 10.0 / 30.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn no_variety_is_no_penalty() {
+        let h = history(&[(1, 0), (1, 5)]);
+        let p = Penalties::new(&Variety::NONE, &h, 10, 100, 100);
+        assert_eq!(p.of(1), 0.0);
+    }
+
+    struct Two;
+    impl PolicyTables for Two {
+        fn states(&self) -> usize {
+            1
+        }
+        fn exit_count(&self) -> usize {
+            1
+        }
+        fn exit_segment(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_frame(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_is_end(&self, _: usize) -> bool {
+            true
+        }
+        fn first_exit(&self, _: usize) -> usize {
+            0
+        }
+        fn u(&self, c: usize, _: usize) -> f32 {
+            [1.0, 1.5][c]
+        }
+        fn u_cont(&self, _: usize, _: usize) -> f32 {
+            0.0
+        }
+        fn successor_count(&self, _: usize) -> usize {
+            2
+        }
+        fn successor(&self, _: usize, k: usize) -> (usize, f32) {
+            (k, 0.0)
+        }
+    }
+
+    #[test]
+    fn a_recent_segment_gives_way_to_the_next_best() {
+        assert_eq!(
+            select(&Two, 0, &[1.0], &Penalties::NONE).choice,
+            Choice::Enter(0)
+        );
+        let v = Variety {
+            recency_cost: 1.0,
+            recency_ms: 0,
+            usage_cost: 0.0,
+            usage_ms: 0,
+        };
+        let p = Penalties::new(&v, &history(&[(0, 95)]), 100, 50, 0);
+        // Segment 0 costs 1 + 0.9 > 1.5.
+        let d = select(&Two, 0, &[1.0], &p);
+        assert_eq!(d.choice, Choice::Enter(1));
+        assert_eq!(d.cost, 1.5);
+    }
 }

@@ -50,6 +50,8 @@ const ALL: &[&str] = &[
     "SuccessorsNotSorted",
     "NoSuccessors",
     "BadControl",
+    "BadContinuation",
+    "BadGroup",
     "TooManyJoints",
     "JointNameCount",
     "BadParent",
@@ -277,6 +279,43 @@ fn every_error_variant_is_reachable() {
         &mutated(&|t| t.strokes = le_u16(&[3, NO_STROKE])),
         BlobError::StrokeOutOfRange { segment: 0 },
     );
+    check(
+        &mutated(&|t| t.continues = vec![0]),
+        BlobError::TableLength {
+            field: Field::Continues,
+            expected: 2,
+            found: 1,
+        },
+    );
+    check(
+        &mutated(&|t| t.groups = vec![0, 0]),
+        BlobError::TableLength {
+            field: Field::Groups,
+            expected: 0,
+            found: 2,
+        },
+    );
+    // Segment 1 is the last: it cannot be continued.
+    check(
+        &mutated(&|t| t.continues = vec![1, 1]),
+        BlobError::BadContinuation { segment: 1 },
+    );
+    check(
+        &mutated(&|t| {
+            t.continues = vec![1, 0];
+            t.seg_start = le_u32(&[0, 2]);
+        }),
+        BlobError::BadContinuation { segment: 0 },
+    );
+    check(
+        &mutated(&|t| t.continues = vec![2, 0]),
+        BlobError::BadContinuation { segment: 0 },
+    );
+    // One channel: a rotation group (three channels) cannot fit.
+    check(
+        &mutated(&|t| t.groups = vec![0, 0, 5]),
+        BlobError::BadGroup { group: 0 },
+    );
 
     // rig.
     check(&mutated(&|t| t.period_us = 0.0), BlobError::BadPwmPeriod);
@@ -424,6 +463,24 @@ fn every_error_variant_is_reachable() {
         &mutated(&|t| t.control.max_wait_ms = 5001),
         BlobError::BadControl {
             field: Field::MaxWait,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.recency_cost = f32::NAN),
+        BlobError::BadControl {
+            field: Field::Recency,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.usage_cost = -1.0),
+        BlobError::BadControl {
+            field: Field::Usage,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.blend_ms = 5001),
+        BlobError::BadControl {
+            field: Field::Blend,
         },
     );
 

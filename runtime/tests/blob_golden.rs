@@ -99,12 +99,18 @@ fn golden_bytes_and_round_trip() {
     );
     assert_eq!(blob.successors(3).len(), 0);
     // control
-    assert_eq!(sz.control, 4);
+    assert_eq!(sz.control, 19);
     let t = blob.timing();
     assert_eq!(
         (t.sync_to_onsets, t.onset_window_ms, t.max_wait_ms),
         (true, 50, 300)
     );
+    let v = blob.variety();
+    assert_eq!(
+        (v.recency_cost, v.recency_ms, v.usage_cost, v.usage_ms),
+        (1.5, 5000, 4.0, 30000)
+    );
+    assert_eq!(blob.blend_ms(), 250);
     // library
     assert_eq!((blob.channels(), blob.frames(), blob.fps()), (1, 6, 30.0));
     assert_eq!(
@@ -119,6 +125,8 @@ fn golden_bytes_and_round_trip() {
     assert_eq!(blob.segment(0).unwrap().stroke, None);
     assert_eq!(blob.segment(0).unwrap().label, None);
     assert_eq!(blob.segment(2), None);
+    assert!(blob.continues(0) && !blob.continues(1) && !blob.continues(2));
+    assert_eq!((blob.group_count(), blob.group(0)), (0, None));
     assert!((blob.frame(0, 3) - 13.0).abs() < 1e-5);
     assert!((blob.segment_value(1, 2, 0) - 8.0).abs() < 1e-5);
     assert_eq!(blob.segment_value(1, 3, 0), 0.0);

@@ -6,6 +6,7 @@ use gesture_runtime::blob::encode::*;
 use gesture_runtime::blob::{Blob, BlobError, ControlSection, FrontEndSection};
 use gesture_runtime::controller::DecisionTiming;
 use gesture_runtime::inference::GmmComponent;
+use gesture_runtime::policy::Variety;
 use gesture_runtime::prosody::ProsodyConfig;
 use gesture_runtime::rig::ChannelCal;
 
@@ -54,9 +55,11 @@ fn constructors_round_trip_through_the_reader() {
             len: 5,
             stroke: (i % 2 == 1).then_some(2),
             label: i as u8,
+            continues: i < 3,
         })
         .collect();
-    let library = OwnedLibrary::new(25.0, 3, &frames, &segs).unwrap();
+    // Channels 0..3 hold one rotation (Z, Y, X: EULER_ORDERS index 5).
+    let library = OwnedLibrary::new(25.0, 3, &frames, &segs, &[(0, 5)]).unwrap();
     // Exits: an interruption at frame 2 of every segment and the end at frame 4.
     let exits: Vec<(usize, usize)> = (0..4).flat_map(|s| [(s, 2), (s, 4)]).collect();
     // End exits: two successors sorted by segment; interruptions: none.
@@ -95,11 +98,17 @@ fn constructors_round_trip_through_the_reader() {
         onset_window_ms: 0,
         max_wait_ms: 120,
     };
+    let variety = Variety {
+        recency_cost: 1.25,
+        recency_ms: 4000,
+        usage_cost: 3.0,
+        usage_ms: 20000,
+    };
     let owned = OwnedPayload {
         front_end: FrontEndSection::from_config(&ProsodyConfig::DEFAULT),
         inference,
         policy,
-        control: ControlSection::from_timing(&timing),
+        control: ControlSection::new(&timing, &variety, 200),
         library,
         rig,
         skeleton: None,
@@ -111,6 +120,10 @@ fn constructors_round_trip_through_the_reader() {
     near(b.crf_weights().obs.get(11), 0.11, 0.11);
     near(b.crf_weights().init.get(2), 0.3, 0.3);
     assert_eq!(b.timing(), timing);
+    assert_eq!(b.variety(), variety);
+    assert_eq!(b.blend_ms(), 200);
+    assert!(b.continues(0) && b.continues(2) && !b.continues(3));
+    assert_eq!((b.group_count(), b.group(0)), (1, Some((0, [2, 1, 0]))));
     // Frames come back within half a quantization step of each channel's range.
     for (f, fr) in frames.iter().enumerate() {
         for (ch, &v) in fr.iter().enumerate() {
@@ -179,9 +192,9 @@ fn builder_errors_are_typed() {
     })
     .unwrap_err();
     assert!(matches!(e, EncodeError::Inconsistent(_)), "{e}");
-    let e = OwnedLibrary::new(30.0, 2, &[vec![1.0]], &[]).unwrap_err();
+    let e = OwnedLibrary::new(30.0, 2, &[vec![1.0]], &[], &[]).unwrap_err();
     assert!(e.to_string().contains("1 values for 2 channels"), "{e}");
-    let e = OwnedLibrary::new(30.0, 1, &[vec![f32::NAN]], &[]).unwrap_err();
+    let e = OwnedLibrary::new(30.0, 1, &[vec![f32::NAN]], &[], &[]).unwrap_err();
     assert!(matches!(e, EncodeError::Inconsistent(_)));
     let e = OwnedRig::new("r", 20_000.0, &[("a\nb".into(), ChannelCal::HOBBY)]).unwrap_err();
     assert!(e.to_string().contains("newline"), "{e}");

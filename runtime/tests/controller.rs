@@ -5,7 +5,7 @@
 use gesture_runtime::controller::{Controller, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::{CrfWeights, GmmComponent, I16Table};
 use gesture_runtime::player::LibraryFrames;
-use gesture_runtime::policy::{Choice, PolicyTables};
+use gesture_runtime::policy::{Choice, PolicyTables, Variety};
 use gesture_runtime::prosody::ProsodyConfig;
 
 /// Three segments of 20, 12 and 30 frames; exits at interruption frames and ends.
@@ -69,6 +69,10 @@ impl LibraryFrames for Lib {
     }
     fn value(&self, c: usize, f: usize, ch: usize) -> f32 {
         (c * 100 + f) as f32 + 1000.0 * ch as f32
+    }
+    /// Segment 1 is segment 0's recorded successor, 2 is 1's; 2 ends a clip.
+    fn continues(&self, c: usize) -> bool {
+        c < 2
     }
 }
 
@@ -136,6 +140,17 @@ fn run_with(audio: &[i16], chunk: usize, finish: bool) -> Vec<Rec> {
 }
 
 fn run_timed(audio: &[i16], chunk: usize, finish: bool, timing: DecisionTiming) -> Vec<Rec> {
+    run_varied(audio, chunk, finish, timing, Variety::NONE, None)
+}
+
+fn run_varied(
+    audio: &[i16],
+    chunk: usize,
+    finish: bool,
+    timing: DecisionTiming,
+    variety: Variety,
+    held: Option<&[f32]>,
+) -> Vec<Rec> {
     let t = tables();
     let lib = Lib { lens: [20, 12, 30] };
     let crf_bytes_init = [0u8; 4];
@@ -160,6 +175,8 @@ fn run_timed(audio: &[i16], chunk: usize, finish: bool, timing: DecisionTiming) 
     let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &lib).unwrap();
     assert_eq!(c.timing(), DecisionTiming::DEFAULT);
     c.set_timing(timing);
+    c.set_variety(variety);
+    c.hold_belief(held);
     let mut out = Vec::new();
     let mut next_tick = 0u64;
     let mut sink = |e: ControllerEvent<'_>| match e {
@@ -357,10 +374,23 @@ const EXITS: [(usize, usize, bool); 5] = [
     (2, 29, true),
 ];
 
+/// The tick at or before `t` that last showed segment `seg`'s last frame (channel 0 =
+/// segment * 100 + frame).
+fn last_frame_tick(recs: &[Rec], seg: usize, t: u64) -> Option<u64> {
+    let last = (seg * 100 + [20, 12, 30][seg] - 1) as f32;
+    recs.iter()
+        .filter_map(|r| match r {
+            Rec::Pose(k, p) if *k <= t && p[0] == last => Some(*k),
+            _ => None,
+        })
+        .max()
+}
+
 #[test]
-fn in_silence_interruptions_pass_and_segment_ends_hold_for_the_longest_wait() {
-    // No speech, no onsets: interruption exits are passed without deciding, and each segment
-    // end holds its last frame for 300 ms (9 ticks at 30 fps) before deciding.
+fn in_silence_interruptions_pass_and_segment_ends_wait_running_on() {
+    // No speech, no onsets: interruption exits are passed without deciding; a segment end
+    // with a recorded successor waits 300 ms (9 ticks at 30 fps) for an onset, the body
+    // running on into the successor meanwhile; a segment end without one decides at once.
     let recs = run(&vec![0i16; 16_000 * 4], 500);
     assert!(!recs.iter().any(|r| matches!(r, Rec::Onset(..))));
     let decisions: Vec<(u64, usize)> = recs
@@ -374,19 +404,30 @@ fn in_silence_interruptions_pass_and_segment_ends_hold_for_the_longest_wait() {
     assert!(decisions.iter().all(|&(_, e)| EXITS[e].2), "{decisions:?}");
     // Segment 0 starts at tick 0 and reaches its last frame (19) at tick 19: decided at 28.
     assert_eq!(decisions[0], (28, 1));
-    // Ticks 19..=28 all show frame 19 of segment 0 (channel 0 = segment * 100 + frame).
+    // Ticks 20..=28 run on into segment 1 (frames 0..=8): the body never freezes.
     for r in &recs {
         if let Rec::Pose(t, p) = r {
-            if (19..=28).contains(t) {
-                assert_eq!(p[0], 19.0, "tick {t}");
+            if (20..=28).contains(t) {
+                assert_eq!(p[0], (100 + t - 20) as f32, "tick {t}");
             }
         }
     }
-    // Each later decision comes 9 ticks after its segment's last frame was first shown.
-    for w in decisions.windows(2) {
-        let seg = EXITS[w[1].1].0;
-        let len = [20u64, 12, 30][seg];
-        assert_eq!(w[1].0, w[0].0 + len + 9, "{w:?}");
+    // No pose repeats the one before it (hard cuts here: no blending).
+    let poses: Vec<f32> = recs
+        .iter()
+        .filter_map(|r| match r {
+            Rec::Pose(_, p) => Some(p[0]),
+            _ => None,
+        })
+        .collect();
+    assert!(poses.windows(2).all(|w| w[0] != w[1]), "a frozen frame");
+    // Every decision: 9 ticks after its segment's last frame showed if that segment has a
+    // recorded successor, at once if not.
+    for &(t, e) in &decisions {
+        let seg = EXITS[e].0;
+        let shown = last_frame_tick(&recs, seg, t).expect("the last frame was shown");
+        let wait = if seg < 2 { 9 } else { 0 };
+        assert_eq!(t, shown + wait, "decision at exit {e}, tick {t}");
     }
     // Deciding at once: the first decision is the interruption exit at tick 9.
     let now = run_timed(
@@ -430,16 +471,86 @@ fn with_speech_every_decision_follows_an_onset_or_the_longest_wait() {
             fresh += 1;
             continue;
         }
-        // Otherwise only a segment end decides, after showing its last frame for 10 ticks.
-        let (seg, frame, end) = EXITS[e];
+        // Otherwise only a segment end decides: after running on for 9 ticks into its recorded
+        // successor, or at once at the end of a clip.
+        let (seg, _, end) = EXITS[e];
         assert!(
             end,
             "interruption exit {e} decided at tick {t} without an onset"
         );
-        let last = (seg * 100 + frame) as f32;
-        assert!((t - 9..=t).all(|k| pose_at(k) == Some(last)), "tick {t}");
+        let shown = last_frame_tick(&recs, seg, t).expect("the last frame was shown");
+        if seg < 2 {
+            assert_eq!(t, shown + 9, "tick {t}");
+            assert!(
+                (shown + 1..=t)
+                    .all(|k| pose_at(k) == Some((100 * (seg + 1)) as f32 + (k - shown - 1) as f32)),
+                "tick {t}: not running on"
+            );
+        } else {
+            assert_eq!(t, shown, "tick {t}");
+        }
         waited += 1;
     }
     assert!(fresh > 0, "no decision on an onset");
     eprintln!("{fresh} decisions on onsets, {waited} after the longest wait");
+}
+
+fn entries(recs: &[Rec]) -> Vec<(u64, usize)> {
+    recs.iter()
+        .filter_map(|r| match r {
+            Rec::Decision(t, _, Choice::Enter(c)) => Some((*t, *c)),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn the_pure_policy_repeats_itself_and_recency_costs_stop_it() {
+    // In silence the belief settles on pause steps: at every end the pure policy enters the
+    // same cheapest segment, over and over (a loop).
+    let silence = vec![0i16; 16_000 * 6];
+    let pure = entries(&run_timed(&silence, 500, false, DecisionTiming::IMMEDIATE));
+    assert!(pure.len() >= 8, "{pure:?}");
+    assert!(pure.iter().all(|&(_, c)| c == pure[0].1), "{pure:?}");
+    // A recency cost larger than the cost differences (5 s window at 30 fps): no segment is
+    // entered again within 5 s while another one is free... but there are only three.
+    let v = Variety {
+        recency_cost: 2.0,
+        recency_ms: 5000,
+        usage_cost: 0.0,
+        usage_ms: 0,
+    };
+    let varied = entries(&run_varied(
+        &silence,
+        500,
+        false,
+        DecisionTiming::IMMEDIATE,
+        v,
+        None,
+    ));
+    let distinct: std::collections::BTreeSet<usize> = varied.iter().map(|&(_, c)| c).collect();
+    assert_eq!(distinct.len(), 3, "{varied:?}");
+    // Never the segment just left at an end (a self-loop would be the most recent entry).
+    for w in varied.windows(2) {
+        assert_ne!(w[0].1, w[1].1, "{varied:?}");
+    }
+}
+
+#[test]
+fn a_held_belief_decides_instead_of_the_crf() {
+    // Belief held on state 0: segment 0 costs 1.0 + 0.5, segment 1 2.0 + 0.2, segment 2
+    // 1.5 + 0.4: always segment 0. Held on state 1: segment 1 (1.0 + 0.2).
+    let silence = vec![0i16; 16_000 * 4];
+    for (held, want) in [([1.0f32, 0.0], 0usize), ([0.0, 1.0], 1)] {
+        let e = entries(&run_varied(
+            &silence,
+            500,
+            false,
+            DecisionTiming::IMMEDIATE,
+            Variety::NONE,
+            Some(&held),
+        ));
+        assert!(!e.is_empty());
+        assert!(e.iter().all(|&(_, c)| c == want), "{held:?}: {e:?}");
+    }
 }

@@ -180,7 +180,7 @@ fn online_controller_beats_random_on_jumps_and_beat_alignment_on_held_out_speech
         argv.extend(extra);
         let rows =
             gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap();
-        let get = |m: &str| rows.iter().find(|r| r.method == m).unwrap().metrics;
+        let get = |m: &str| rows.rows.iter().find(|r| r.method == m).unwrap().metrics;
         let (online, random) = (get("online"), get("random"));
         eprintln!(
             "{name}: jump at cuts {:.2} vs random {:.2}; beat alignment {:.3} vs random {:.3}; \

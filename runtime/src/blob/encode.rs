@@ -19,6 +19,7 @@ use super::skeleton::{BvhChannel, Drive};
 use super::{Blob, BlobError, Header};
 use crate::controller::DecisionTiming;
 use crate::inference::{CrfWeights, GmmComponent, I16Table};
+use crate::policy::Variety;
 use crate::prosody::ProsodyConfig;
 use crate::rig::ChannelCal;
 
@@ -329,6 +330,8 @@ pub struct SegmentSpec {
     pub stroke: Option<usize>,
     /// Semantic label (0 = none).
     pub label: u8,
+    /// The next segment continues this one (its recorded successor, stored right after it).
+    pub continues: bool,
 }
 
 /// Owned `library` section.
@@ -354,6 +357,10 @@ pub struct OwnedLibrary {
     pub strokes: Vec<u8>,
     /// `u8` per segment.
     pub labels: Vec<u8>,
+    /// `u8` per segment.
+    pub continues: Vec<u8>,
+    /// Rotation-group records.
+    pub groups: Vec<u8>,
 }
 
 impl OwnedLibrary {
@@ -370,17 +377,21 @@ impl OwnedLibrary {
             frame_values: &self.frame_values,
             strokes: &self.strokes,
             labels: &self.labels,
+            continues: &self.continues,
+            groups: &self.groups,
         }
     }
 
     /// Quantizes `frames` (one `Vec` of channel values in degrees per frame, all of length
     /// `channels`) per channel over its range ([`quantize_range`]: error at most half a step,
-    /// range / 65534), and lays out `segments`.
+    /// range / 65534), and lays out `segments` and the rotation `groups` (first channel, Euler
+    /// order as an [`EULER_ORDERS`](super::EULER_ORDERS) index).
     pub fn new(
         fps: f64,
         channels: usize,
         frames: &[Vec<f32>],
         segments: &[SegmentSpec],
+        groups: &[(usize, u8)],
     ) -> Result<Self, EncodeError> {
         if let Some((i, f)) = frames.iter().enumerate().find(|(_, f)| f.len() != channels) {
             return inconsistent(alloc::format!(
@@ -432,6 +443,15 @@ impl OwnedLibrary {
             frame_values: q.iter().flat_map(|v| v.to_le_bytes()).collect(),
             strokes,
             labels: segments.iter().map(|s| s.label).collect(),
+            continues: segments.iter().map(|s| s.continues as u8).collect(),
+            groups: groups
+                .iter()
+                .map(|&(first, order)| {
+                    let [a, b] = fit::<u16>("group channel", first, "u16")?.to_le_bytes();
+                    Ok([a, b, order])
+                })
+                .collect::<Result<Vec<[u8; 3]>, EncodeError>>()?
+                .concat(),
         })
     }
 }
@@ -658,6 +678,7 @@ impl OwnedPayload {
             len: 3,
             stroke,
             label,
+            continues: false,
         };
         let policy = OwnedPolicy::new(&PolicyInput {
             states: 2,
@@ -674,14 +695,20 @@ impl OwnedPayload {
         });
         let inference =
             OwnedInference::new(&[gmm], 1, &[1.0, -1.0], &[1.0, 0.0, 0.0, 1.0], &[1.0, -1.0]);
-        let library = OwnedLibrary::new(30.0, 1, &frames, &[seg(0, None, 0), seg(3, Some(1), 2)]);
+        let library = OwnedLibrary::new(
+            30.0,
+            1,
+            &frames,
+            &[seg(0, None, 0), seg(3, Some(1), 2)],
+            &[],
+        );
         let rig = OwnedRig::new("example", 20_000.0, &[("head".into(), ChannelCal::HOBBY)]);
         match (inference, policy, library, rig) {
             (Ok(inference), Ok(policy), Ok(library), Ok(rig)) => Self {
                 front_end: FrontEndSection::from_config(&ProsodyConfig::DEFAULT),
                 inference,
                 policy,
-                control: ControlSection::from_timing(&DecisionTiming::DEFAULT),
+                control: ControlSection::new(&DecisionTiming::DEFAULT, &Variety::NONE, 0),
                 library,
                 rig,
                 skeleton: None,

@@ -83,6 +83,12 @@ pub enum Field {
     OnsetWindow,
     /// `control.max_wait_ms`.
     MaxWait,
+    /// `control.recency_cost` / `control.recency_ms`.
+    Recency,
+    /// `control.usage_cost` / `control.usage_ms`.
+    Usage,
+    /// `control.blend_ms`.
+    Blend,
     /// `library.channels`.
     Channels,
     /// `library.frames`.
@@ -99,6 +105,10 @@ pub enum Field {
     Strokes,
     /// `library.labels`.
     Labels,
+    /// `library.continues`.
+    Continues,
+    /// `library.groups`.
+    Groups,
     /// `rig.calibration`.
     Calibration,
     /// `skeleton.joints`.
@@ -140,6 +150,9 @@ impl Field {
             Self::SyncToOnsets => "control.sync_to_onsets",
             Self::OnsetWindow => "control.onset_window_ms",
             Self::MaxWait => "control.max_wait_ms",
+            Self::Recency => "control.recency_cost",
+            Self::Usage => "control.usage_cost",
+            Self::Blend => "control.blend_ms",
             Self::Channels => "library.channels",
             Self::Frames => "library.frames",
             Self::SegStart => "library.seg_start",
@@ -148,6 +161,8 @@ impl Field {
             Self::FrameValues => "library.frame_values",
             Self::Strokes => "library.strokes",
             Self::Labels => "library.labels",
+            Self::Continues => "library.continues",
+            Self::Groups => "library.groups",
             Self::Calibration => "rig.calibration",
             Self::Joints => "skeleton.joints",
             Self::Parents => "skeleton.parents",
@@ -309,6 +324,17 @@ pub enum BlobError {
         /// Segment index.
         segment: u32,
     },
+    /// A segment claims a continuation that is not the next segment stored right after it.
+    BadContinuation {
+        /// Segment index.
+        segment: u32,
+    },
+    /// A rotation group's channels are out of range, overlap the previous group, or its
+    /// order is unknown.
+    BadGroup {
+        /// Group record index.
+        group: u32,
+    },
     // --- rig ---
     /// `rig.period_us` is not finite, not above the longest pulse or above
     /// [`PERIOD_MAX_US`](crate::rig::PERIOD_MAX_US).
@@ -448,6 +474,8 @@ impl BlobError {
             Self::EmptySegment { .. } => "EmptySegment",
             Self::SegmentOutOfFrames { .. } => "SegmentOutOfFrames",
             Self::StrokeOutOfRange { .. } => "StrokeOutOfRange",
+            Self::BadContinuation { .. } => "BadContinuation",
+            Self::BadGroup { .. } => "BadGroup",
             Self::BadPwmPeriod => "BadPwmPeriod",
             Self::BadCalibration { .. } => "BadCalibration",
             Self::ChannelNameCount { .. } => "ChannelNameCount",
@@ -586,6 +614,16 @@ impl fmt::Display for BlobError {
             Self::StrokeOutOfRange { segment } => write!(
                 f,
                 "library segment {segment}: stroke frame is not within the segment"
+            ),
+            Self::BadContinuation { segment } => write!(
+                f,
+                "segment {segment} claims a continuation, but the next segment does not start \
+                 right after it"
+            ),
+            Self::BadGroup { group } => write!(
+                f,
+                "rotation group {group} names channels out of range or overlapping, or an \
+                 unknown order"
             ),
             Self::BadPwmPeriod => f.write_str(
                 "rig.period_us must be finite, above 2500 us and at most 100000 us \

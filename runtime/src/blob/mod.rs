@@ -60,7 +60,7 @@ pub use payload::{
     ControlSection, FrontEndSection, I16Section, InferenceSection, LibrarySection, Payload,
     PolicySection, RigSection, SkeletonSection, CALIBRATION_RECORD_BYTES, DRIVE_RECORD_BYTES,
     END_SITE_RECORD_BYTES, EXIT_RECORD_BYTES, FRAME_SCALE_RECORD_BYTES, GMM_RECORD_BYTES,
-    NO_STROKE, ROOT_PARENT, SUCCESSOR_RECORD_BYTES,
+    GROUP_RECORD_BYTES, NO_STROKE, ROOT_PARENT, SUCCESSOR_RECORD_BYTES,
 };
 pub use quantize::{quantize_range, quantize_symmetric, Quantization, QUANT_MAX};
 pub use records::{calibration_from_record, calibration_record, gmm_from_record, gmm_record};
@@ -81,3 +81,7 @@ pub const MAX_FPS: f32 = 1000.0;
 pub const MAX_ONSET_WINDOW_MS: u16 = 1000;
 /// Longest wait for an onset at a segment's end in the `control` section (ms).
 pub const MAX_WAIT_MS: u16 = 5000;
+/// Largest recency or usage cost of the `control` section (cost units).
+pub const MAX_VARIETY_COST: f32 = 1.0e6;
+/// Longest inertialization time of the `control` section (ms).
+pub const MAX_BLEND_MS: u16 = 5000;

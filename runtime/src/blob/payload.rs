@@ -26,6 +26,8 @@ pub const CALIBRATION_RECORD_BYTES: usize = 7 * 4;
 pub const NO_STROKE: u16 = 0xFFFF;
 /// Bytes of one skeleton end-site record (`joint: u16`, then `x, y, z: f32`).
 pub const END_SITE_RECORD_BYTES: usize = 2 + 3 * 4;
+/// Bytes of one rotation-group record (`first: u16`, `order: u8`).
+pub const GROUP_RECORD_BYTES: usize = 3;
 /// Bytes of one skeleton drive record (`joint: u16`, `chain_top: u16`, `axis: u8`, `mode: u8`).
 pub const DRIVE_RECORD_BYTES: usize = 6;
 /// `skeleton.parents` value of a root joint.
@@ -200,8 +202,9 @@ pub struct PolicySection<'a> {
 }
 
 /// How the controller runs the policy: when it decides
-/// ([`DecisionTiming`](crate::controller::DecisionTiming)).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// ([`DecisionTiming`](crate::controller::DecisionTiming)), how it varies its choices
+/// ([`Variety`](crate::policy::Variety)) and how the player blends at cuts.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ControlSection {
     /// 1: decisions wait for syllable onsets; 0: every exit point decides at once.
     pub sync_to_onsets: u8,
@@ -209,16 +212,36 @@ pub struct ControlSection {
     pub onset_window_ms: u16,
     /// Longest wait for an onset at a segment's end (ms, <= 5000).
     pub max_wait_ms: u16,
+    /// Cost added to a candidate entered just now, falling linearly to 0 at `recency_ms`.
+    pub recency_cost: f32,
+    /// Recency window (ms).
+    pub recency_ms: u16,
+    /// Cost per unit of a candidate's share of the frames played in the last `usage_ms`.
+    pub usage_cost: f32,
+    /// Usage window (ms).
+    pub usage_ms: u16,
+    /// Inertialization time at cuts (ms): the pose offset decays over this time.
+    pub blend_ms: u16,
 }
 
 impl ControlSection {
-    /// The section holding `t` (durations saturate at `u16::MAX`).
-    pub fn from_timing(t: &crate::controller::DecisionTiming) -> Self {
+    /// The section for timing `t`, variety `v` and blend time `blend_ms` (durations saturate
+    /// at `u16::MAX`).
+    pub fn new(
+        t: &crate::controller::DecisionTiming,
+        v: &crate::policy::Variety,
+        blend_ms: u32,
+    ) -> Self {
         let ms = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
         Self {
             sync_to_onsets: t.sync_to_onsets as u8,
             onset_window_ms: ms(t.onset_window_ms),
             max_wait_ms: ms(t.max_wait_ms),
+            recency_cost: v.recency_cost,
+            recency_ms: ms(v.recency_ms),
+            usage_cost: v.usage_cost,
+            usage_ms: ms(v.usage_ms),
+            blend_ms: ms(blend_ms),
         }
     }
 }
@@ -252,6 +275,15 @@ pub struct LibrarySection<'a> {
     /// `u8` per segment: semantic label, 0 = none.
     #[serde(borrow)]
     pub labels: &'a [u8],
+    /// `u8` per segment: 1 if the next segment's frames continue it (the recorded successor,
+    /// stored right after it), else 0.
+    #[serde(borrow)]
+    pub continues: &'a [u8],
+    /// Rotation groups: records `{first: u16, order: u8}`, three channels
+    /// `first..first + 3` holding one joint rotation as Euler angles in that order
+    /// ([`EULER_ORDERS`](super::EULER_ORDERS) index), blended as rotations; sorted, disjoint.
+    #[serde(borrow)]
+    pub groups: &'a [u8],
 }
 
 /// The output rig: channel names and servo calibration.

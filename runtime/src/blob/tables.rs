@@ -55,4 +55,13 @@ impl LibraryFrames for Blob<'_> {
     fn value(&self, c: usize, f: usize, ch: usize) -> f32 {
         self.segment_value(c, f, ch)
     }
+    fn continues(&self, c: usize) -> bool {
+        Blob::continues(self, c)
+    }
+    fn group_count(&self) -> usize {
+        Blob::group_count(self)
+    }
+    fn group(&self, g: usize) -> (usize, [u8; 3]) {
+        Blob::group(self, g).unwrap_or((usize::MAX, [0, 1, 2]))
+    }
 }

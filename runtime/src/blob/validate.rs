@@ -9,7 +9,8 @@ use super::payload::*;
 use super::records::{calibration_from_record, f32_at, record, u16_at, u32_at};
 use super::skeleton::{Drive, MAX_JOINTS};
 use super::{
-    MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES, MAX_ONSET_WINDOW_MS, MAX_SEGMENTS, MAX_WAIT_MS,
+    MAX_BLEND_MS, MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES, MAX_ONSET_WINDOW_MS, MAX_SEGMENTS,
+    MAX_VARIETY_COST, MAX_WAIT_MS,
 };
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
 use crate::rig::validate_period;
@@ -152,6 +153,14 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
     length(Field::FrameValues, l.frame_values, frames * ch, 2)?;
     length(Field::Strokes, l.strokes, segs, 2)?;
     length(Field::Labels, l.labels, segs, 1)?;
+    length(Field::Continues, l.continues, segs, 1)?;
+    if l.groups.len() % GROUP_RECORD_BYTES != 0 {
+        return Err(BlobError::TableLength {
+            field: Field::Groups,
+            expected: l.groups.len() - l.groups.len() % GROUP_RECORD_BYTES,
+            found: l.groups.len(),
+        });
+    }
     for c in 0..ch {
         let (scale, offset) = (
             f32_at(l.frame_scales, 2 * c).unwrap_or(f32::NAN),
@@ -180,6 +189,30 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
         if stroke != NO_STROKE && stroke >= len {
             return Err(BlobError::StrokeOutOfRange { segment });
         }
+    }
+    for s in 0..segs {
+        match l.continues.get(s).copied().unwrap_or(0) {
+            0 => {}
+            1 => {
+                let end = u32_at(l.seg_start, s).unwrap_or(0) as u64
+                    + u16_at(l.seg_len, s).unwrap_or(0) as u64;
+                let next = u32_at(l.seg_start, s + 1).map(u64::from);
+                if next != Some(end) {
+                    return Err(BlobError::BadContinuation { segment: s as u32 });
+                }
+            }
+            _ => return Err(BlobError::BadContinuation { segment: s as u32 }),
+        }
+    }
+    let mut free = 0usize;
+    for g in 0..l.groups.len() / GROUP_RECORD_BYTES {
+        let bad = BlobError::BadGroup { group: g as u32 };
+        let r = record::<GROUP_RECORD_BYTES>(l.groups, g).ok_or(bad)?;
+        let first = u16::from_le_bytes([r[0], r[1]]) as usize;
+        if first < free || first + 3 > ch || r[2] as usize >= super::EULER_ORDERS.len() {
+            return Err(bad);
+        }
+        free = first + 3;
     }
     Ok(())
 }
@@ -349,6 +382,7 @@ fn policy<'a>(
 
 fn control(c: &ControlSection) -> Result<(), BlobError> {
     let bad = |field| Err(BlobError::BadControl { field });
+    let cost_ok = |v: f32| v.is_finite() && (0.0..=MAX_VARIETY_COST).contains(&v);
     if c.sync_to_onsets > 1 {
         return bad(Field::SyncToOnsets);
     }
@@ -357,6 +391,15 @@ fn control(c: &ControlSection) -> Result<(), BlobError> {
     }
     if c.max_wait_ms > MAX_WAIT_MS {
         return bad(Field::MaxWait);
+    }
+    if !cost_ok(c.recency_cost) {
+        return bad(Field::Recency);
+    }
+    if !cost_ok(c.usage_cost) {
+        return bad(Field::Usage);
+    }
+    if c.blend_ms > MAX_BLEND_MS {
+        return bad(Field::Blend);
     }
     Ok(())
 }

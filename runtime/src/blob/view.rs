@@ -17,6 +17,7 @@ use super::skeleton::SkeletonView;
 use super::validate;
 use crate::controller::DecisionTiming;
 use crate::inference::{CrfWeights, GmmComponent, I16Table, MAX_CLUSTERS};
+use crate::policy::Variety;
 #[cfg(doc)]
 use crate::prosody::FrontEnd;
 use crate::prosody::ProsodyConfig;
@@ -353,6 +354,22 @@ impl<'a> Blob<'a> {
         }
     }
 
+    /// How the controller varies its choices (the `control` section).
+    pub fn variety(&self) -> Variety {
+        let c = &self.payload.control;
+        Variety {
+            recency_cost: c.recency_cost,
+            recency_ms: c.recency_ms as u32,
+            usage_cost: c.usage_cost,
+            usage_ms: c.usage_ms as u32,
+        }
+    }
+
+    /// The player's inertialization time at cuts (ms).
+    pub fn blend_ms(&self) -> u32 {
+        self.payload.control.blend_ms as u32
+    }
+
     // --- library ---
 
     /// Output channels (1..=[`MAX_CHANNELS`](super::MAX_CHANNELS)).
@@ -380,6 +397,25 @@ impl<'a> Blob<'a> {
             stroke: (stroke != NO_STROKE).then_some(stroke),
             label: NonZeroU8::new(*l.labels.get(s)?),
         })
+    }
+
+    /// Whether segment `s + 1` continues segment `s` (stored right after it: the recorded
+    /// successor); false out of range.
+    pub fn continues(&self, s: usize) -> bool {
+        self.payload.library.continues.get(s) == Some(&1)
+    }
+
+    /// Rotation groups (records of `library.groups`).
+    pub fn group_count(&self) -> usize {
+        self.payload.library.groups.len() / GROUP_RECORD_BYTES
+    }
+
+    /// Rotation group `g`: its first channel and its Euler order (axis indices), `None` out of
+    /// range.
+    pub fn group(&self, g: usize) -> Option<(usize, [u8; 3])> {
+        let r = record::<GROUP_RECORD_BYTES>(self.payload.library.groups, g)?;
+        let order = *super::skeleton::EULER_ORDERS.get(r[2] as usize)?;
+        Some((u16::from_le_bytes([r[0], r[1]]) as usize, order))
     }
 
     /// Value of channel `ch` at frame `f` of the frame table (degrees; 0 out of range).

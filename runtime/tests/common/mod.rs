@@ -64,6 +64,8 @@ pub struct Tiny {
     pub frame_values: Vec<u8>,
     pub strokes: Vec<u8>,
     pub labels: Vec<u8>,
+    pub continues: Vec<u8>,
+    pub groups: Vec<u8>,
     pub rig_name: String,
     pub period_us: f32,
     pub calibration: Vec<u8>,
@@ -152,6 +154,11 @@ impl Tiny {
                 sync_to_onsets: 1,
                 onset_window_ms: 50,
                 max_wait_ms: 300,
+                recency_cost: 1.5,
+                recency_ms: 5000,
+                usage_cost: 4.0,
+                usage_ms: 30000,
+                blend_ms: 250,
             },
             channels: 1,
             fps: 30.0,
@@ -163,6 +170,8 @@ impl Tiny {
             frame_values: le_i16(&[0, 100, 200, 300, -100, -200]),
             strokes: le_u16(&[NO_STROKE, 1]),
             labels: vec![0, 2],
+            continues: vec![1, 0],
+            groups: vec![],
             rig_name: "tiny".into(),
             period_us: 20_000.0,
             calibration: calibration_record(&ChannelCal::HOBBY).to_vec(),
@@ -213,6 +222,8 @@ impl Tiny {
                 frame_values: &self.frame_values,
                 strokes: &self.strokes,
                 labels: &self.labels,
+                continues: &self.continues,
+                groups: &self.groups,
             },
             rig: RigSection {
                 name: &self.rig_name,
@@ -255,11 +266,12 @@ pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-/// The tiny blob's bytes (format version 3: the `control` section is `01 32 ac 02` after
-/// `policy.succ_cost_scale`). Changing the format changes these: bump FORMAT_VERSION and
-/// update docs/blob-format.md with them.
+/// The tiny blob's bytes (format version 4: the `control` section after
+/// `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01`; the library
+/// ends with `continues` `02 01 00` and no `groups`, `00`). Changing the format changes
+/// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(
-    "4753544203000000b30100006f94459a",
+    "4753544204000000c6010000dd463b00",
     "807d00009642000016448fc2f53c6666e63e0ad7233c3333b33e295c0f3e0000",
     "00400000c8410000c84100008c42061902010134000000bf000080bf0000803e",
     "0000c0bf000000400000003f000080400000a0bf0000003e0000003f000080be",
@@ -267,13 +279,14 @@ pub const GOLDEN: &str = concat!(
     "033b04f4010cfe0202036666663f0000003f080a0014001e0028000000803e0c",
     "0100020003000400050006000c00000200010001000100020010000000000200",
     "0000020000000400000010000005000100fbff0000070001000000cdcccc3d01",
-    "32ac02010000f04106020800000000030000000403000300080ad7233c000020",
-    "410c00006400c8002c019cff38ff04ffff01000200020474696e7900409c461c",
-    "000000000000b4c20000b4420000803f0080bb440000204100007a4304686561",
-    "64010209686970730a6865616404ffff00001800000000000000000000000000",
-    "00000000002041000000000206030900010205030405030424000000000000b4",
-    "42000000000000000000000000000000000000000000000000000000000e0100",
-    "000000000000a0400000000006010001000101",
+    "32ac020000c03f882700008040b0ea01fa01010000f041060208000000000300",
+    "00000403000300080ad7233c000020410c00006400c8002c019cff38ff04ffff",
+    "0100020002020100000474696e7900409c461c000000000000b4c20000b44200",
+    "00803f0080bb440000204100007a430468656164010209686970730a68656164",
+    "04ffff0000180000000000000000000000000000000000002041000000000206",
+    "030900010205030405030424000000000000b442000000000000000000000000",
+    "000000000000000000000000000000000e0100000000000000a0400000000006",
+    "010001000101",
 );
 
 pub fn postcard_len<T: serde::Serialize>(v: &T) -> usize {

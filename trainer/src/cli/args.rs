@@ -130,22 +130,85 @@ pub fn parse_span(s: &str) -> Result<(f64, f64), String> {
     Ok((a, b))
 }
 
-/// Decision timing options shared by `pack` and `eval-motion`.
+/// How the device runs the policy: options shared by `pack` and `eval-motion`, stored in the
+/// blob's `control` section (and the lower-body choice, applied to the library's frames).
 #[derive(Debug, Clone, clap::Args)]
-pub struct TimingArgs {
+pub struct DeviceArgs {
     /// Decide at every exit point at once instead of on syllable onsets (the runtime's
-    /// `DecisionTiming::IMMEDIATE`; stored in the blob).
+    /// `DecisionTiming::IMMEDIATE`).
     #[arg(long)]
     pub immediate: bool,
+    /// An onset detected this recently counts as "now" (ms).
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.onset_window_ms)]
+    pub onset_window_ms: u32,
+    /// Longest wait for an onset at a segment's end (ms; the body runs on meanwhile).
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.max_wait_ms)]
+    pub max_wait_ms: u32,
+    /// Cost of entering a segment entered just now, falling to 0 over --recency-ms (0: no
+    /// recency cost).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_cost)]
+    pub recency_cost: f32,
+    /// Recency window (ms).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_ms)]
+    pub recency_ms: u32,
+    /// Cost per unit of a segment's share of the frames played in the last --usage-ms.
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_cost)]
+    pub usage_cost: f32,
+    /// Usage window (ms).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_ms)]
+    pub usage_ms: u32,
+    /// Inertialization time at cuts (ms; 0: hard cuts).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_BLEND_MS)]
+    pub blend_ms: u32,
+    /// Play the library's legs as captured (feet may slide) instead of holding the lower
+    /// body in a standing pose.
+    #[arg(long)]
+    pub free_legs: bool,
 }
 
-impl TimingArgs {
-    /// The timing the blob records.
-    pub fn timing(&self) -> DecisionTiming {
-        if self.immediate {
+impl DeviceArgs {
+    /// Refuses values the blob cannot hold.
+    pub fn validate(&self) -> Result<(), CliError> {
+        for (name, v) in [
+            ("--recency-cost", self.recency_cost),
+            ("--usage-cost", self.usage_cost),
+        ] {
+            if !(v.is_finite() && (0.0..=1.0e6).contains(&v)) {
+                return Err(format!("{name} must be a number from 0 to 1e6, not {v}").into());
+            }
+        }
+        for (name, v, max) in [
+            ("--recency-ms", self.recency_ms, 65_535),
+            ("--usage-ms", self.usage_ms, 65_535),
+            ("--blend-ms", self.blend_ms, 5_000),
+            ("--onset-window-ms", self.onset_window_ms, 1_000),
+            ("--max-wait-ms", self.max_wait_ms, 5_000),
+        ] {
+            if v > max {
+                return Err(format!("{name} must be at most {max}, not {v}").into());
+            }
+        }
+        Ok(())
+    }
+
+    /// Applies these settings to `opts`.
+    pub fn apply(&self, opts: &mut crate::pack::PackOptions) {
+        opts.timing = if self.immediate {
             DecisionTiming::IMMEDIATE
         } else {
-            DecisionTiming::DEFAULT
-        }
+            DecisionTiming {
+                sync_to_onsets: true,
+                onset_window_ms: self.onset_window_ms,
+                max_wait_ms: self.max_wait_ms,
+            }
+        };
+        opts.variety = gesture_runtime::policy::Variety {
+            recency_cost: self.recency_cost,
+            recency_ms: self.recency_ms,
+            usage_cost: self.usage_cost,
+            usage_ms: self.usage_ms,
+        };
+        opts.blend_ms = self.blend_ms;
+        opts.plant_feet = !self.free_legs;
     }
 }

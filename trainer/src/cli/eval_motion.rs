@@ -1,12 +1,12 @@
 //! `gesture-train eval-motion`: motion quality of the online controller on held-out audio
-//! against random selection, the offline DP and the real motion capture
-//! (`crate::evaluate::motion`).
+//! against its ablations, random selection, the offline DP and the real motion capture
+//! (`crate::evaluate::motion`), as a table or JSON.
 
 use std::path::PathBuf;
 
-use super::args::{parse_span, ControlArgs, CorpusArgs, TimingArgs};
+use super::args::{parse_span, ControlArgs, CorpusArgs, DeviceArgs};
 use super::CliError;
-use crate::evaluate::motion::{evaluate_motion, MotionEval, Row};
+use crate::evaluate::motion::{evaluate_motion, Evaluation, MotionEval};
 use crate::inference::model::InferenceModel;
 use crate::pack::PackOptions;
 
@@ -19,17 +19,18 @@ pub struct EvalMotionArgs {
     /// Gesture library (BVH files or folders).
     #[arg(long, required = true, num_args = 1..)]
     pub library: Vec<PathBuf>,
-    /// Held-out speech (WAV).
-    #[arg(long)]
-    pub audio: PathBuf,
-    /// The real motion of that speech (BVH), for the Hellinger distance and as a reference.
+    /// Held-out speech: one or more WAV files, played one after the other.
+    #[arg(long, required = true, num_args = 1..)]
+    pub audio: Vec<PathBuf>,
+    /// The real motion of that speech (BVH; one audio file), for the Hellinger distance and
+    /// as a reference row.
     #[arg(long)]
     pub mocap: Option<PathBuf>,
     /// Use only START:END seconds of the audio (and motion capture).
     #[arg(long, value_parser = parse_span)]
     pub span: Option<(f64, f64)>,
     /// Random runs to average.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub random_runs: u64,
     /// Print one JSON object.
     #[arg(long)]
@@ -40,68 +41,89 @@ pub struct EvalMotionArgs {
     /// Control-layer options.
     #[command(flatten)]
     pub control: ControlArgs,
-    /// Decision timing.
+    /// How the device runs the policy.
     #[command(flatten)]
-    pub timing: TimingArgs,
+    pub device: DeviceArgs,
 }
 
 impl EvalMotionArgs {
     /// The evaluation these flags ask for.
     pub fn settings(&self) -> Result<MotionEval, CliError> {
         self.control.validate()?;
+        self.device.validate()?;
+        let mut pack = PackOptions {
+            control: self.control.params(),
+            effectors: self.load.options().effectors,
+            ..PackOptions::default()
+        };
+        self.device.apply(&mut pack);
         Ok(MotionEval {
             library: self.library.clone(),
             audio: self.audio.clone(),
             mocap: self.mocap.clone(),
             span: self.span,
             random_runs: self.random_runs,
-            pack: PackOptions {
-                control: self.control.params(),
-                timing: self.timing.timing(),
-                effectors: self.load.options().effectors,
-                ..PackOptions::default()
-            },
+            pack,
         })
     }
 }
 
-/// Evaluates and returns the rows (online, random, dp, and mocap when given).
-pub fn evaluate(a: &EvalMotionArgs) -> Result<Vec<Row>, CliError> {
+/// Evaluates (see [`evaluate_motion`]).
+pub fn evaluate(a: &EvalMotionArgs) -> Result<Evaluation, CliError> {
     let settings = a.settings()?;
     let model = InferenceModel::load(&a.model)?;
     Ok(evaluate_motion(&model, &settings)?)
 }
 
+fn opt(v: Option<f64>, prec: usize) -> String {
+    v.map_or_else(|| "-".into(), |x| format!("{x:.prec$}"))
+}
+
 /// Runs the command.
 pub fn run(a: &EvalMotionArgs) -> Result<(), CliError> {
-    let rows = evaluate(a)?;
+    let ev = evaluate(a)?;
     if a.json {
-        outln!(
-            "{}",
-            serde_json::to_string(&serde_json::json!({ "rows": rows }))?
-        )?;
+        outln!("{}", serde_json::to_string(&ev)?)?;
         return Ok(());
     }
     outln!(
-        "{:<11} {:>9} {:>12} {:>10} {:>8} {:>10}",
-        "method",
-        "hellinger",
-        "mean_jerk",
-        "jump_cuts",
-        "cuts/s",
-        "beat_align"
+        "{:.1} s of audio, library of {} segments; {} online decisions, variety regret {:.2}%",
+        ev.seconds,
+        ev.library_segments,
+        ev.decisions,
+        100.0 * ev.variety_regret
     )?;
-    for r in &rows {
+    outln!("variety                 distinct  of lib   max share  entropy  repeats<5s  cuts/s")?;
+    outln!("                        (segs)    (%)      (%)        (bits)   (%)         (1/s)")?;
+    for r in &ev.rows {
         let m = &r.metrics;
         outln!(
-            "{:<11} {:>9} {:>12.0} {:>10.2} {:>8.2} {:>10.3}",
+            "{:<22} {:>8} {:>8} {:>10.1} {:>8.2} {:>11.1} {:>7.2}",
             r.method,
-            m.hellinger.map_or("-".into(), |h| format!("{h:.3}")),
-            m.mean_jerk,
-            m.jump_at_cuts,
-            m.cuts_per_s,
-            m.beat_alignment
+            m.distinct_segments,
+            opt(m.library_share.map(|v| 100.0 * v), 1),
+            100.0 * m.max_segment_share,
+            m.usage_entropy_bits,
+            100.0 * m.repeat_5s_share,
+            m.cuts_per_s
         )?;
     }
-    Ok(())
+    outln!("motion                  still  foot speed  jerk         jump at cuts  max jump  p99 step  beat   hand speed")?;
+    outln!("                        (%)    (cm/s)      (cm/s3)      (cm)          (cm)      (cm)      align  Hellinger")?;
+    for r in &ev.rows {
+        let m = &r.metrics;
+        outln!(
+            "{:<22} {:>5.1} {:>11} {:>12.0} {:>13.2} {:>9.2} {:>9.2} {:>6.3} {:>10}",
+            r.method,
+            100.0 * m.still_share,
+            opt(m.foot_speed, 2),
+            m.mean_jerk,
+            m.jump_at_cuts,
+            m.max_jump_at_cuts,
+            m.p99_step,
+            m.beat_alignment,
+            opt(m.hellinger, 3)
+        )?;
+    }
+    outln!("(lengths in skeleton units: cm on the shared data)")
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::args::{ControlArgs, CorpusArgs, TimingArgs};
+use super::args::{ControlArgs, CorpusArgs, DeviceArgs};
 use super::CliError;
 use crate::output::write_atomic;
 use crate::pack::{pack, PackOptions};
@@ -37,22 +37,24 @@ pub struct PackArgs {
     /// Control-layer options.
     #[command(flatten)]
     pub control: ControlArgs,
-    /// Decision timing.
+    /// How the device runs the policy.
     #[command(flatten)]
-    pub timing: TimingArgs,
+    pub device: DeviceArgs,
 }
 
 /// Runs the command.
 pub fn run(a: &PackArgs) -> Result<(), CliError> {
     a.control.validate()?;
-    let opts = PackOptions {
+    a.device.validate()?;
+    let mut opts = PackOptions {
         control: a.control.params(),
-        timing: a.timing.timing(),
         rig: a.rig.clone(),
         budget_bytes: a.budget_bytes,
         effectors: a.load.options().effectors,
         no_skeleton: a.no_skeleton,
+        ..PackOptions::default()
     };
+    a.device.apply(&mut opts);
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
     outln!(
         "wrote {}: {} bytes (front-end {}, inference {}, policy {}, control {}, library {}, \
@@ -74,6 +76,12 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.frames,
         r.rig,
         r.channels
+    )?;
+    outln!(
+        "lower body: {}",
+        r.lower_body
+            .as_deref()
+            .unwrap_or("as captured (no legs, or --free-legs)")
     )?;
     outln!(
         "successors: {} of {} kept ({:.2}% pruned{}); regret {:.4}%, agreement {:.2}% over {} simulated decisions",

@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use gesture_runtime::policy::{select, Choice, PolicyTables};
+use gesture_runtime::policy::{select, Choice, Penalties, PolicyTables};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -155,7 +155,7 @@ pub fn regret(
             belief = nb.iter().map(|v| v / z).collect();
         }
         let bf: Vec<f32> = belief.iter().map(|&v| v as f32).collect();
-        let dq = select(q, e, &bf);
+        let dq = select(q, e, &bf, &Penalties::NONE);
         let chosen = match dq.choice {
             Choice::Continue => Action::Continue,
             Choice::Enter(c) => Action::Enter(c),

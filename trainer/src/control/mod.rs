@@ -7,7 +7,8 @@
 //!   and the decision rule;
 //! - [`prune`]: dropping successors that are never optimal, and budget truncation;
 //! - [`dp`]: the offline dynamic-programming reference;
-//! - [`build`]: model + library to a solved, pruned, quantized policy and its regret.
+//! - [`build`]: model + library to a solved, pruned policy and its regret.
+//! - [`schedule`]: what random selection and the offline DP reference play, frame by frame.
 
 // Index loops mirror the recursion's subscripts and are kept on purpose.
 #![allow(clippy::needless_range_loop)]
@@ -18,7 +19,7 @@ pub mod dp;
 pub mod library;
 pub mod mdp;
 pub mod prune;
-pub mod quality;
+pub mod schedule;
 
 pub use library::{ExitPoint, LibSegment, Library};
 pub use mdp::{Action, MdpParams, Policy};

@@ -4,4 +4,5 @@
 //! - [`motion`]: motion quality of the online controller on held-out audio against random
 //!   selection, the offline DP reference and the motion capture.
 
+pub mod metrics;
 pub mod motion;

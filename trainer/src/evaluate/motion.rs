@@ -1,46 +1,67 @@
-//! Motion quality on held-out audio (`gesture-train eval-motion`): the online controller
-//! against random selection from the same library, the offline DP reference and, where the
-//! audio has its own motion capture, the real motion (metrics in [`crate::control::quality`]).
+//! Motion quality on held-out audio (`gesture-train eval-motion`): every method's motion,
+//! measured the same way ([`crate::evaluate::metrics`]):
 //!
-//! **The online row runs the bytes `pack` writes.** The model and library are packed in
-//! memory ([`pack_model`]), the bytes are read back with `Blob::parse` and run through the
-//! runtime's device loop ([`Device`]) on the audio's samples, with the blob's decision timing:
-//! exactly what a board does, detection latencies included.
+//! - `online`: the controller as a board runs it;
+//! - `online_pure`: the same without variety costs (the paper's decision rule);
+//! - `online_prior`: an ablation, the belief held at the state prior (the speech's prosody
+//!   no longer informs the choice; decisions are still timed on its onsets);
+//! - `online_shuffled`: an ablation, the controller on the audio cut into 1 s blocks played
+//!   in a shuffled order (seeded), measured against the real audio's onsets;
+//! - `random`: a uniformly random segment at every segment end (mean over seeded runs; the
+//!   variety figures are of the first run);
+//! - `offline_dp`: the offline dynamic-programming sequence (posteriors that see the whole
+//!   utterance);
+//! - `mocap`: the motion capture of the audio, when given (with its root motion).
+//!
+//! **Everything runs the bytes `pack` writes.** The model and library are packed in memory
+//! ([`pack_model`]) and read back with `Blob::parse`; the online methods run the runtime's
+//! device loop ([`Device`]) on the audio's samples, and random and DP are played through the
+//! runtime's own [`Player`] over the blob's frames (the same inertialized cuts). Every pose is
+//! put back on the library's skeleton ([`PoseSkeleton`]) and measured there, so the figures
+//! describe what a viewer of the character sees.
+//!
+//! **Regret of variety.** For every decision of the online run, the float, unpruned policy's
+//! expected cost of the choice made is compared with the best choice under the same belief
+//! (variety costs excluded): `variety_regret` is the excess over the best, as a fraction.
 
 use std::path::PathBuf;
 
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::{BlobController, ControllerEvent};
-use gesture_runtime::device::{Device, DeviceError, DeviceEvent, NullPin};
+use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::inference::StepNormalizer;
-use gesture_runtime::policy::{Choice, PolicyTables};
+use gesture_runtime::player::{LibraryFrames, Player, MAX_CHANNELS};
+use gesture_runtime::policy::{Choice, Variety};
 use gesture_runtime::prosody::{ProsodyConfig, StepKind};
-use gesture_runtime::rig::MAX_CHANNELS;
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use crate::control::quality::{
-    cut_frames, is_cut, metrics, play_dp, play_random, positions, Metrics, Played,
-};
-use crate::control::Library;
+use super::metrics::{entries_from_frames, measure, Entry, MotionMetrics, Trace};
+use crate::control::mdp::Action;
+use crate::control::schedule::{play_dp, play_random, Played};
 use crate::inference::model::InferenceModel;
 use crate::inference::train::prosody_point;
-use crate::motion::{analyze, read_bvh, SegmentParams};
+use crate::motion::{analyze, read_bvh, Motion, SegmentParams};
 use crate::pack::{pack_model, PackError, PackOptions};
+use crate::rig::PoseSkeleton;
 
 /// What to evaluate.
 #[derive(Clone, Debug)]
 pub struct MotionEval {
     /// Gesture library (BVH files or folders).
     pub library: Vec<PathBuf>,
-    /// Held-out speech.
-    pub audio: PathBuf,
-    /// The real motion of that speech.
+    /// Held-out speech: one or more WAV files, played one after the other.
+    pub audio: Vec<PathBuf>,
+    /// The real motion of that speech (one audio file only).
     pub mocap: Option<PathBuf>,
     /// Only this span of the audio (and motion capture), seconds.
     pub span: Option<(f64, f64)>,
     /// Random runs to average.
     pub random_runs: u64,
-    /// How to pack (costs, timing, effectors); the rig is the library's full skeleton.
+    /// How to pack (costs, device settings, effectors); the rig is the library's full
+    /// skeleton.
     pub pack: PackOptions,
 }
 
@@ -49,9 +70,24 @@ pub struct MotionEval {
 pub struct Row {
     /// Method name.
     pub method: String,
-    /// Its metrics.
+    /// Its figures.
     #[serde(flatten)]
-    pub metrics: Metrics,
+    pub metrics: MotionMetrics,
+}
+
+/// An evaluation's result.
+#[derive(Debug, Clone, Serialize)]
+pub struct Evaluation {
+    /// One row per method.
+    pub rows: Vec<Row>,
+    /// Library segments.
+    pub library_segments: usize,
+    /// Online decisions.
+    pub decisions: usize,
+    /// Expected-cost excess of the online choices over the pure policy's best (fraction).
+    pub variety_regret: f64,
+    /// Seconds of audio.
+    pub seconds: f64,
 }
 
 /// Why an evaluation failed.
@@ -66,13 +102,10 @@ pub enum EvalError {
     /// Reading the motion capture.
     #[error(transparent)]
     Bvh(#[from] crate::motion::BvhError),
-    /// Analysing the motion capture.
+    /// Analysing motion, speech or the options.
     #[error("{0}")]
-    Analysis(String),
-    /// The front-end refused the audio's settings.
-    #[error("{0}")]
-    Features(String),
-    /// The device refused the packed blob (a packer bug).
+    Input(String),
+    /// The device refused the packed blob or a pose could not be rebuilt (a packer bug).
     #[error("the packed blob: {0}")]
     Device(String),
 }
@@ -88,77 +121,214 @@ impl EvalError {
     }
 }
 
-fn mean(ms: &[Metrics]) -> Metrics {
-    let n = ms.len().max(1) as f64;
-    Metrics {
-        hellinger: ms
-            .iter()
-            .map(|m| m.hellinger)
-            .sum::<Option<f64>>()
-            .map(|v| v / n),
-        mean_jerk: ms.iter().map(|m| m.mean_jerk).sum::<f64>() / n,
-        jump_at_cuts: ms.iter().map(|m| m.jump_at_cuts).sum::<f64>() / n,
-        cuts_per_s: ms.iter().map(|m| m.cuts_per_s).sum::<f64>() / n,
-        beat_alignment: ms.iter().map(|m| m.beat_alignment).sum::<f64>() / n,
-    }
+/// What a playback showed: per tick the pose, and the segment and frame it came from.
+#[derive(Clone, Debug, Default)]
+pub struct Playback {
+    /// One pose per tick (rig channels, degrees).
+    pub poses: Vec<Vec<f32>>,
+    /// Per tick, (segment, frame) shown.
+    pub shown: Vec<(usize, usize)>,
 }
 
-/// Online play as the device does it: the blob through the runtime's device loop (starting
-/// at segment 0), fed `samples`. Returns `frames` played frames (the last one held if the
-/// audio ends earlier).
-pub fn play_blob(
-    lib: &Library,
+/// One online decision: exit, choice, and the belief it was made with.
+#[derive(Clone, Debug)]
+struct Made {
+    exit: usize,
+    choice: Choice,
+    belief: Vec<f64>,
+}
+
+/// Runs the blob's device loop on `samples` (starting at segment 0), after `setup` on its
+/// controller; returns the first `frames` ticks (the last one repeated if the audio ends
+/// earlier) and the decisions.
+fn play_online(
     blob: &Blob<'_>,
     samples: &[i16],
     frames: usize,
-) -> Result<Vec<Played>, DeviceError> {
+    setup: impl FnOnce(&mut BlobController<'_>),
+) -> Result<(Playback, Vec<Made>), EvalError> {
     let mut slot = Box::new(None);
-    let controller =
-        BlobController::from_blob_in(&mut slot, blob).map_err(DeviceError::Controller)?;
+    let controller = BlobController::from_blob_in(&mut slot, blob)
+        .map_err(|e| EvalError::Device(e.to_string()))?;
+    setup(controller);
     let mut device: Device<'_, '_, NullPin, MAX_CHANNELS> =
-        Device::new(controller, [NullPin; MAX_CHANNELS])?;
-    let mut out: Vec<Played> = Vec::with_capacity(frames + 1);
-    let mut cut_next = false;
+        Device::new(controller, [NullPin; MAX_CHANNELS])
+            .map_err(|e| EvalError::Device(e.to_string()))?;
+    let mut out = Playback::default();
+    let mut made = Vec::new();
+    let states = blob.states();
+    let mut belief: Vec<f64> = vec![1.0 / states as f64; states];
     // Null pins cannot fail.
     let _ = device.push(samples, &mut |ev| match ev {
-        DeviceEvent::Controller(ControllerEvent::Pose { segment, frame, .. }) => {
-            out.push(Played {
-                segment,
-                frame,
-                cut: std::mem::take(&mut cut_next),
-            });
+        DeviceEvent::Controller(ControllerEvent::Pose {
+            pose,
+            segment,
+            frame,
+            ..
+        }) => {
+            out.poses.push(pose.to_vec());
+            out.shown.push((segment, frame));
         }
-        DeviceEvent::Controller(ControllerEvent::Decision { decision, .. }) => {
-            if let Choice::Enter(c) = decision.choice {
-                let e = decision.exit;
-                cut_next = is_cut(lib, blob.exit_segment(e), c, blob.exit_is_end(e));
-            }
+        DeviceEvent::Controller(ControllerEvent::Step { belief: b, .. }) => {
+            belief = b.iter().map(|&v| v as f64).collect();
         }
+        DeviceEvent::Controller(ControllerEvent::Decision { decision, .. }) => made.push(Made {
+            exit: decision.exit,
+            choice: decision.choice,
+            belief: belief.clone(),
+        }),
         _ => {}
     });
-    out.truncate(frames);
-    if let Some(&last) = out.last() {
-        out.resize(frames, Played { cut: false, ..last });
-    }
-    Ok(out)
+    hold_to(&mut out, frames);
+    Ok((out, made))
 }
 
-/// Evaluates `model` on `e` and returns the rows (online, random, offline DP, and mocap when
-/// given).
-pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Vec<Row>, EvalError> {
-    let packed = pack_model(model, &e.library, &e.pack)?;
+/// Truncates or extends (repeating the last tick) a playback to `frames` ticks.
+fn hold_to(p: &mut Playback, frames: usize) {
+    p.poses.truncate(frames);
+    p.shown.truncate(frames);
+    if let (Some(pose), Some(&shown)) = (p.poses.last().cloned(), p.shown.last()) {
+        p.poses.resize(frames, pose);
+        p.shown.resize(frames, shown);
+    }
+}
+
+/// Plays a schedule of library frames through the runtime's player over the blob's frames,
+/// with the blob's inertialization at every entry.
+pub fn play_schedule(blob: &Blob<'_>, schedule: &[Played]) -> Playback {
+    let mut player = Player::new();
+    let blend = (blob.blend_ms() as f64 * blob.fps() as f64 / 1000.0).ceil() as u32;
+    player.set_blend_ticks(blend);
+    let mut out = Playback::default();
+    let mut pose = [0.0f32; MAX_CHANNELS];
+    let n = blob.channels();
+    for (t, p) in schedule.iter().enumerate() {
+        let entered = t > 0 && (p.segment != schedule[t - 1].segment || p.frame == 0);
+        if entered {
+            player.enter(blob, p.segment);
+        }
+        let f = player.tick(blob, &mut pose);
+        out.poses.push(pose[..n].to_vec());
+        out.shown.push((player.segment(), f));
+    }
+    out
+}
+
+/// The trace of a playback on the blob's skeleton.
+fn trace_of(
+    blob: &Blob<'_>,
+    skeleton: &PoseSkeleton,
+    p: &Playback,
+    pack: &PackOptions,
+) -> Result<Trace, EvalError> {
+    let motion = skeleton
+        .motion(&p.poses, blob.fps() as f64)
+        .map_err(|e| EvalError::Device(e.to_string()))?;
+    let entries = entries_from_frames(&p.shown, |s| blob.continues(s), |s| blob.segment_len(s));
+    Trace::from_motion(&motion, &pack.effectors, entries).map_err(EvalError::Device)
+}
+
+/// The audio's samples (files in order, the span applied) at the model's rate.
+fn load_audio(model: &InferenceModel, e: &MotionEval) -> Result<Vec<i16>, EvalError> {
+    let rate = model.sample_rate_hz as f64;
+    let mut all = Vec::new();
+    for path in &e.audio {
+        let pcm = crate::audio::load_wav_at(path, model.sample_rate_hz)?;
+        let (s0, s1) = e.span.unwrap_or((0.0, f64::INFINITY));
+        let i0 = ((s0 * rate) as usize).min(pcm.samples.len());
+        let i1 = ((s1 * rate).min(pcm.samples.len() as f64) as usize).max(i0);
+        all.extend_from_slice(&pcm.samples[i0..i1]);
+    }
+    Ok(all)
+}
+
+/// The audio cut into 1 s blocks and played in a seeded shuffled order.
+pub fn shuffle_blocks(samples: &[i16], rate: u32, seed: u64) -> Vec<i16> {
+    let block = rate.max(1) as usize;
+    let mut blocks: Vec<&[i16]> = samples.chunks(block).collect();
+    blocks.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
+    blocks.concat()
+}
+
+/// The motion capture of the span as a trace (its own segmentation gives the entries).
+fn mocap_trace(
+    path: &std::path::Path,
+    e: &MotionEval,
+    frames_at: impl Fn(f64) -> usize,
+) -> Result<(Trace, Motion), EvalError> {
+    let mo = read_bvh(path)?;
+    let s0 = e.span.map_or(0.0, |s| s.0);
+    let f0 = ((s0 * mo.fps()) as usize).min(mo.frames());
+    let f1 = (f0 + frames_at(mo.fps())).min(mo.frames());
+    let sub = mo
+        .slice(f0, f1)
+        .ok_or_else(|| EvalError::Input(format!("{}: no frames in the span", path.display())))?;
+    let an = analyze(&sub, &e.pack.effectors, &SegmentParams::default())
+        .map_err(|x| EvalError::Input(format!("{}: {x}", path.display())))?;
+    let entries: Vec<Entry> = an
+        .segments
+        .iter()
+        .enumerate()
+        .map(|(k, s)| Entry {
+            frame: s.start_frame,
+            segment: k,
+            cut: false,
+        })
+        .collect();
+    let t = Trace::from_motion(&sub, &e.pack.effectors, entries).map_err(EvalError::Input)?;
+    Ok((t, sub))
+}
+
+fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
+    let n = ms.len().max(1) as f64;
+    let avg = |f: fn(&MotionMetrics) -> f64| ms.iter().map(f).sum::<f64>() / n;
+    let avg_opt =
+        |f: fn(&MotionMetrics) -> Option<f64>| ms.iter().map(f).sum::<Option<f64>>().map(|v| v / n);
+    MotionMetrics {
+        seconds: avg(|m| m.seconds),
+        still_share: avg(|m| m.still_share),
+        foot_speed: avg_opt(|m| m.foot_speed),
+        mean_jerk: avg(|m| m.mean_jerk),
+        jump_at_cuts: avg(|m| m.jump_at_cuts),
+        max_jump_at_cuts: ms.iter().map(|m| m.max_jump_at_cuts).fold(0.0, f64::max),
+        p99_step: avg(|m| m.p99_step),
+        cuts_per_s: avg(|m| m.cuts_per_s),
+        beat_alignment: avg(|m| m.beat_alignment),
+        beats_per_s: avg(|m| m.beats_per_s),
+        beat_chance: avg(|m| m.beat_chance),
+        beat_lift: avg(|m| m.beat_lift),
+        hellinger: avg_opt(|m| m.hellinger),
+        // Variety of one run (averages of counts mean little).
+        ..ms.first().copied().unwrap_or_default()
+    }
+}
+
+/// Evaluates `model` on `e` (see the module docs).
+pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluation, EvalError> {
+    if e.audio.is_empty() {
+        return Err(EvalError::Input("no audio to evaluate on".into()));
+    }
+    if e.mocap.is_some() && e.audio.len() != 1 {
+        return Err(EvalError::Input(
+            "--mocap goes with one audio file (its own speech)".into(),
+        ));
+    }
+    let mut pack = e.pack.clone();
+    pack.rig = None;
+    pack.no_skeleton = false;
+    let packed = pack_model(model, &e.library, &pack)?;
     let lib = &packed.library;
     let cm = &packed.control;
     let blob = Blob::parse(&packed.bytes).map_err(|x| EvalError::Device(x.to_string()))?;
-    let pcm = crate::audio::load_wav_at(&e.audio, model.sample_rate_hz)?;
-    let rate = model.sample_rate_hz as f64;
-    let (s0, s1) = e.span.unwrap_or((0.0, f64::INFINITY));
-    let i0 = ((s0 * rate) as usize).min(pcm.samples.len());
-    let i1 = ((s1 * rate).min(pcm.samples.len() as f64) as usize).max(i0);
-    let samples = &pcm.samples[i0..i1];
+    let skeleton = blob
+        .skeleton()
+        .ok_or_else(|| EvalError::Device("no skeleton section".into()))
+        .and_then(|v| PoseSkeleton::from_blob(&v).map_err(|x| EvalError::Device(x.to_string())))?;
+    let samples = load_audio(model, e)?;
+    let rate = model.sample_rate_hz;
     let config: ProsodyConfig = blob.prosody_config();
-    let (_, steps) = crate::features::prosody_of(samples, &config)
-        .map_err(|x| EvalError::Features(x.to_string()))?;
+    let (_, steps) = crate::features::prosody_of(&samples, &config)
+        .map_err(|x| EvalError::Input(x.to_string()))?;
     let mut norm = StepNormalizer::new();
     let m: Vec<Vec<f64>> = steps
         .iter()
@@ -170,71 +340,125 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Vec<Row
         model.crf.posteriors(&m)
     };
     let fps = lib.fps;
-    let frames = ((samples.len() as f64 / rate) * fps) as usize;
-    let prior = model.state_prior.clone();
-    let post = |t: usize| {
-        let time = t as f64 / fps;
-        match steps.iter().position(|s| s.end_s() > time) {
-            Some(k) => offline[k].clone(),
-            None => offline.last().cloned().unwrap_or_else(|| prior.clone()),
-        }
-    };
+    let seconds = samples.len() as f64 / rate as f64;
+    let frames = (seconds * fps) as usize;
     let onsets: Vec<f64> = steps
         .iter()
         .filter(|s| s.kind == StepKind::Syllable)
         .map(|s| s.start_s())
         .collect();
-    let effectors = &e.pack.effectors;
-    let real = match &e.mocap {
-        Some(p) => {
-            let mo = read_bvh(p)?;
-            let an = analyze(&mo, effectors, &SegmentParams::default())
-                .map_err(|x| EvalError::Analysis(format!("{}: {x}", p.display())))?;
-            let f0 = (s0 * mo.fps()) as usize;
-            Some(
-                (f0..(f0 + frames).min(an.positions.frames()))
-                    .map(|f| an.positions.frame(f).to_vec())
-                    .collect::<Vec<_>>(),
-            )
-        }
+    let reference = match &e.mocap {
+        Some(p) => Some(mocap_trace(p, e, |mo_fps| (seconds * mo_fps) as usize)?),
         None => None,
     };
-    let real_ref = real.as_deref();
-    let eval = |seq: &[Played]| {
-        metrics(
-            &positions(lib, seq),
-            &cut_frames(seq),
-            fps,
-            &onsets,
-            real_ref,
-        )
+    let ref_hands = reference.as_ref().map(|(t, _)| (t.hands.clone(), t.fps));
+    let segments = lib.segments.len();
+    let measured = |p: &Playback| -> Result<MotionMetrics, EvalError> {
+        let t = trace_of(&blob, &skeleton, p, &pack)?;
+        // Hand speeds are compared at the reference's own rate.
+        let r = ref_hands.as_ref().map(|(h, f)| (h.as_slice(), *f));
+        Ok(measure(&t, &onsets, Some(segments), r))
     };
-    // The device starts at segment 0, so the references start there too.
-    let start = 0;
-    let online =
-        play_blob(lib, &blob, samples, frames).map_err(|x| EvalError::Device(x.to_string()))?;
-    let mut rows = vec![Row {
+    let mut rows = Vec::new();
+
+    // The device, as packed.
+    let (online, made) = play_online(&blob, &samples, frames, |_| {})?;
+    if std::env::var_os("GESTURE_DEBUG_JUMPS").is_some() {
+        let t = trace_of(&blob, &skeleton, &online, &pack)?;
+        for f in 1..t.frames() {
+            let d: f64 = t.hands[f - 1]
+                .iter()
+                .zip(&t.hands[f])
+                .map(|(a, b)| {
+                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+                })
+                .sum::<f64>()
+                / 2.0;
+            if d > 4.0 {
+                eprintln!(
+                    "frame {f}: step {d:.2} shown {:?} -> {:?}",
+                    online.shown[f - 1],
+                    online.shown[f]
+                );
+            }
+        }
+    }
+    rows.push(Row {
         method: "online".into(),
-        metrics: eval(&online),
-    }];
-    let random: Vec<Metrics> = (0..e.random_runs.max(1))
-        .map(|seed| eval(&play_random(lib, frames, start, seed)))
-        .collect();
+        metrics: measured(&online)?,
+    });
+    let pure = play_online(&blob, &samples, frames, |c| c.set_variety(Variety::NONE))?.0;
+    rows.push(Row {
+        method: "online_pure".into(),
+        metrics: measured(&pure)?,
+    });
+    let prior: Vec<f32> = model.state_prior.iter().map(|&v| v as f32).collect();
+    let held = play_online(&blob, &samples, frames, |c| c.hold_belief(Some(&prior)))?.0;
+    rows.push(Row {
+        method: "online_prior".into(),
+        metrics: measured(&held)?,
+    });
+    let shuffled = shuffle_blocks(&samples, rate, 11);
+    let sh = play_online(&blob, &shuffled, frames, |_| {})?.0;
+    rows.push(Row {
+        method: "online_shuffled".into(),
+        metrics: measured(&sh)?,
+    });
+    // References, played by the same player.
+    let start = 0;
+    let random: Vec<MotionMetrics> = (0..e.random_runs.max(1))
+        .map(|seed| {
+            measured(&play_schedule(
+                &blob,
+                &play_random(lib, frames, start, seed),
+            ))
+        })
+        .collect::<Result<_, _>>()?;
     rows.push(Row {
         method: "random".into(),
         metrics: mean(&random),
     });
     if !offline.is_empty() {
+        let prior64 = model.state_prior.clone();
+        let post = |t: usize| {
+            let time = t as f64 / fps;
+            match steps.iter().position(|s| s.end_s() > time) {
+                Some(k) => offline[k].clone(),
+                None => offline.last().cloned().unwrap_or_else(|| prior64.clone()),
+            }
+        };
+        let plan = play_dp(lib, &cm.policy, &cm.psi, frames, start, &post);
         rows.push(Row {
             method: "offline_dp".into(),
-            metrics: eval(&play_dp(lib, &cm.policy, &cm.psi, frames, start, &post)),
+            metrics: measured(&play_schedule(&blob, &plan))?,
         });
     }
-    if let Some(r) = real_ref {
+    if let Some((t, _)) = &reference {
         rows.push(Row {
             method: "mocap".into(),
-            metrics: metrics(r, &[], fps, &onsets, Some(r)),
+            metrics: measure(t, &onsets, None, Some((&t.hands, t.fps))),
         });
     }
-    Ok(rows)
+    // What variety costs against the pure policy.
+    let (mut excess, mut best_total) = (0.0, 0.0);
+    for d in &made {
+        let chosen = match d.choice {
+            Choice::Continue => Action::Continue,
+            Choice::Enter(c) => Action::Enter(c),
+        };
+        let best = cm.policy.decide(d.exit, &d.belief, 0..segments);
+        let cb = cm.policy.cost(d.exit, best, &d.belief);
+        let cc = cm.policy.cost(d.exit, chosen, &d.belief);
+        if cb.is_finite() && cc.is_finite() {
+            excess += (cc - cb).max(0.0);
+            best_total += cb.abs();
+        }
+    }
+    Ok(Evaluation {
+        rows,
+        library_segments: segments,
+        decisions: made.len(),
+        variety_regret: excess / best_total.max(1e-12),
+        seconds,
+    })
 }

@@ -260,6 +260,19 @@ impl Motion {
         self.frame(f)?.get(start + k).copied()
     }
 
+    /// Frames `from..to` (clamped) as a motion of their own; `None` if that is empty.
+    pub fn slice(&self, from: usize, to: usize) -> Option<Motion> {
+        let to = to.min(self.frames);
+        if from >= to {
+            return None;
+        }
+        let n = self.skeleton.channel_count();
+        let mut m = self.clone();
+        m.data = self.data[from * n..to * n].to_vec();
+        m.frames = to - from;
+        Some(m)
+    }
+
     /// Takes the motion apart: skeleton, frame time, frame count, data.
     pub fn into_parts(self) -> (Skeleton, f64, usize, Vec<f64>) {
         (self.skeleton, self.frame_time, self.frames, self.data)

@@ -7,7 +7,7 @@ use gesture_runtime::blob::encode::{
     encode, EncodeError, JointSpec, OwnedInference, OwnedLibrary, OwnedPolicy, OwnedRig,
     OwnedSkeleton, PolicyInput, SegmentSpec,
 };
-use gesture_runtime::blob::{ControlSection, FrontEndSection, Payload};
+use gesture_runtime::blob::{ControlSection, FrontEndSection, Payload, EULER_ORDERS};
 use gesture_runtime::prosody::ProsodyConfig;
 use gesture_runtime::rig::ChannelCal;
 
@@ -17,7 +17,7 @@ use crate::control::Library;
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::inference_section;
 use crate::motion::Skeleton;
-use crate::rig::Rig;
+use crate::rig::{AngleMode, Rig};
 
 /// Every section but the policy.
 pub struct Parts {
@@ -69,11 +69,16 @@ pub fn parts(
     let segments: Vec<SegmentSpec> = lib
         .segments
         .iter()
-        .map(|s| SegmentSpec {
+        .enumerate()
+        .map(|(i, s)| SegmentSpec {
             start: offsets[s.take] + s.start,
             len: s.len(),
             stroke: None,
             label: 0,
+            // The recorded successor is stored right after (segments of a take are
+            // contiguous and in order).
+            continues: s.next == Some(i + 1)
+                && lib.segments.get(i + 1).is_some_and(|n| n.start == s.end),
         })
         .collect();
     let cals: Vec<(String, ChannelCal)> = rig
@@ -107,8 +112,18 @@ pub fn parts(
         Parts {
             front_end: FrontEndSection::from_config(&config),
             inference: inference_section(&model.gmm, &model.crf)?,
-            control: ControlSection::from_timing(&opts.timing),
-            library: OwnedLibrary::new(lib.fps, rig.channels.len(), &frames, &segments)?,
+            control: ControlSection::new(&opts.timing, &opts.variety, opts.blend_ms),
+            library: OwnedLibrary::new(
+                lib.fps,
+                rig.channels.len(),
+                &frames,
+                &segments,
+                &rotation_groups(
+                    rig,
+                    &lib.takes[0].motion.skeleton().clone(),
+                    &lib.takes[0].source.display().to_string(),
+                )?,
+            )?,
             rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
             skeleton,
         },
@@ -159,4 +174,41 @@ pub fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, Encod
         rig: parts.rig.section(),
         skeleton: parts.skeleton.as_ref().map(OwnedSkeleton::section),
     })
+}
+
+/// The rig's rotation groups: three consecutive channels that read one joint's own BVH
+/// rotation channels (the full-skeleton rig), as (first channel, Euler order index). The
+/// player blends them as one rotation.
+pub fn rotation_groups(
+    rig: &Rig,
+    skeleton: &Skeleton,
+    source: &str,
+) -> Result<Vec<(usize, u8)>, PackError> {
+    let bound = rig.bind(skeleton, source)?;
+    let ch = bound.channels();
+    let mut groups = Vec::new();
+    let mut k = 0;
+    while k + 3 <= ch.len() {
+        let three = &ch[k..k + 3];
+        let same_joint = three.iter().all(|c| c.joint == three[0].joint);
+        let raw = three
+            .iter()
+            .all(|c| c.mode == AngleMode::Channel && !c.axis.negated);
+        let order = [
+            three[0].axis.index,
+            three[1].axis.index,
+            three[2].axis.index,
+        ];
+        let code = EULER_ORDERS
+            .iter()
+            .position(|o| [o[0] as usize, o[1] as usize, o[2] as usize] == order);
+        match (same_joint && raw, code) {
+            (true, Some(code)) => {
+                groups.push((k, code as u8));
+                k += 3;
+            }
+            _ => k += 1,
+        }
+    }
+    Ok(groups)
 }

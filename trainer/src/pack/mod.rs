@@ -20,6 +20,7 @@
 //! never reads it; it costs a few KiB for a 75-joint body).
 
 pub mod assemble;
+pub mod plant;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -27,6 +28,7 @@ use std::time::Instant;
 use gesture_runtime::blob::encode::EncodeError;
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::DecisionTiming;
+use gesture_runtime::policy::Variety;
 use serde::Serialize;
 
 use crate::control::build::{build, fit_budget, regret, ControlModel, ControlParams};
@@ -34,13 +36,27 @@ use crate::control::library::LibraryError;
 use crate::control::Library;
 use crate::corpus::discover;
 use crate::inference::model::{InferenceModel, ModelError};
-use crate::motion::{EffectorSpec, SegmentParams, Skeleton};
+use crate::motion::fk::Target;
+use crate::motion::{EffectorSpec, Motion, SegmentParams, Skeleton};
 use crate::output::{write_atomic, OutputError};
 use crate::rig::{Rig, RigError};
 use assemble::{encode_with, parts, policy_section};
 
+/// Variety costs a blob gets by default (see `gesture_runtime::policy`): chosen with
+/// `gesture-train eval-motion` on held-out spans of the ZeroEGGS takes (README, "Motion
+/// quality").
+pub const DEFAULT_VARIETY: Variety = Variety {
+    recency_cost: 1.0,
+    recency_ms: 8000,
+    usage_cost: 4.0,
+    usage_ms: 30000,
+};
+
+/// Inertialization time at cuts a blob gets by default (ms).
+pub const DEFAULT_BLEND_MS: u32 = 400;
+
 /// Settings of a pack.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct PackOptions {
     /// Rig file (default: every rotation channel of the library's skeleton).
     pub rig: Option<PathBuf>,
@@ -50,10 +66,32 @@ pub struct PackOptions {
     pub control: ControlParams,
     /// When the device decides (the blob's `control` section).
     pub timing: DecisionTiming,
+    /// How the device varies its choices (the blob's `control` section).
+    pub variety: Variety,
+    /// Inertialization time at cuts (ms; the blob's `control` section).
+    pub blend_ms: u32,
+    /// Hold the lower body of a skeleton with legs in a standing pose (see `plant`).
+    pub plant_feet: bool,
     /// End effectors for segmenting the library.
     pub effectors: EffectorSpec,
     /// Leave out the host-side skeleton section.
     pub no_skeleton: bool,
+}
+
+impl Default for PackOptions {
+    fn default() -> Self {
+        Self {
+            rig: None,
+            budget_bytes: None,
+            control: ControlParams::default(),
+            timing: DecisionTiming::default(),
+            variety: DEFAULT_VARIETY,
+            blend_ms: DEFAULT_BLEND_MS,
+            plant_feet: true,
+            effectors: EffectorSpec::default(),
+            no_skeleton: false,
+        }
+    }
 }
 
 /// Bytes per blob section.
@@ -129,6 +167,8 @@ pub struct PackReport {
     pub channels: usize,
     /// Library frames stored.
     pub frames: usize,
+    /// How the lower body is played (`null`: as captured, or no legs).
+    pub lower_body: Option<String>,
     /// Timings.
     pub timings: PackTimings,
 }
@@ -229,7 +269,7 @@ pub fn pack_model(
     if files.is_empty() {
         return Err(PackError::NoBvh);
     }
-    let lib = Library::from_files(
+    let mut lib = Library::from_files(
         &files,
         &model.normalization,
         &opts.effectors,
@@ -250,6 +290,11 @@ pub fn pack_model(
             });
         }
     }
+    let lower_body = if opts.plant_feet {
+        hold_lower_body(&mut lib, &opts.effectors)
+    } else {
+        None
+    };
     let (parts, frames) = parts(model, &lib, &rig, opts)?;
     let load_s = start.elapsed().as_secs_f64();
 
@@ -310,6 +355,16 @@ pub fn pack_model(
         rig: rig.name.clone(),
         channels: rig.channels.len(),
         frames,
+        lower_body: lower_body.map(|p| {
+            format!(
+                "held in a standing pose ({} joints: the legs, {} and above), {}'s rotation \
+                 moved into {}",
+                p.held_joints,
+                p.pelvis,
+                p.pelvis,
+                p.upper.join(", ")
+            )
+        }),
         timings: PackTimings {
             load_s,
             costs_s: cm.timings.costs,
@@ -326,6 +381,26 @@ pub fn pack_model(
         library: lib,
         control: cm,
     })
+}
+
+/// Holds the lower body of the library's takes (see [`plant`]); `None` without feet.
+fn hold_lower_body(lib: &mut Library, effectors: &EffectorSpec) -> Option<plant::Planted> {
+    let first = lib.takes.first()?;
+    let hands: Vec<usize> = effectors
+        .resolve(first.motion.skeleton(), first.motion.source())
+        .ok()?
+        .targets
+        .iter()
+        .map(|t| match *t {
+            Target::Joint(j) | Target::EndSite(j) => j,
+        })
+        .collect();
+    let mut motions: Vec<Motion> = lib.takes.iter().map(|t| t.motion.clone()).collect();
+    let planted = plant::plant_feet(&mut motions, &hands)?;
+    for (t, m) in lib.takes.iter_mut().zip(motions) {
+        t.motion = m;
+    }
+    Some(planted)
 }
 
 /// Loads the model at `model_path`, packs it with the BVH files in `library` and writes the

@@ -1,0 +1,621 @@
+//! What a viewer sees, in numbers: the motion-quality metrics of one played (or captured)
+//! motion (docs/method.md, "Beyond the paper: motion that looks alive").
+//!
+//! A [`Trace`] is a motion as shown: per frame, the world positions of the hands and the feet
+//! and the joint rotation channels, and the list of segment entries (when which library
+//! segment started, and whether it started with a cut). [`Trace::from_motion`] builds it from
+//! any BVH motion (a capture, or the poses a controller played put back on the library's
+//! skeleton), so the same figures come from `gesture-train eval-motion` and from a
+//! `gesture-sim run` output folder. The figures ([`MotionMetrics`]):
+//!
+//! - **variety** (from the entries): distinct segments and their share of the library, the
+//!   largest share of the frames any one segment takes, the entropy of the frame shares
+//!   (bits), and the share of entries that repeat a segment entered less than 5 s before;
+//! - **freezes**: the share of frames inside whole-body still runs: at least 0.2 s during
+//!   which no rotation channel moves more than 0.05 degrees per frame at 30 fps (1.5 deg/s,
+//!   scaled to the trace's frame rate);
+//! - **feet**: the median speed of the foot and toe joints (skeleton units per second: cm/s on
+//!   the shared data), when the skeleton has feet;
+//! - **smoothness**: the mean magnitude of the hands' jerk (third difference, units/s^3); the
+//!   hands' displacement across the frame of each cut (units, mean and largest); the 99th
+//!   percentile of the hands' displacement per frame over the whole motion;
+//! - **timing**: beat alignment (BEAT's beat consistency: each syllable onset scores
+//!   `exp(-d^2 / (2 * 0.3^2))` for the distance `d` (s) to the nearest motion beat, a local
+//!   minimum of the mean hand speed smoothed over 1/6 s);
+//! - **the hands' speed distribution** against a reference (GENEA's Hellinger distance of
+//!   hand-speed histograms, 10 units/s bins up to 250 and one overflow bin).
+//!
+//! Pure functions of their inputs; no panics on empty or short traces (figures of an empty
+//! trace are 0).
+
+use std::collections::{BTreeMap, HashMap};
+
+use serde::Serialize;
+
+use crate::motion::fk::{FkError, FkPlan, Target, Vec3};
+use crate::motion::{EffectorSpec, Motion, Skeleton};
+
+/// Seconds within which entering a segment again counts as a repeat.
+pub const REPEAT_WINDOW_S: f64 = 5.0;
+/// Shortest still run counted as a freeze (s).
+pub const STILL_RUN_S: f64 = 0.2;
+/// A channel moving less than this per frame at 30 fps is still (degrees).
+pub const STILL_DEG_PER_FRAME_30FPS: f64 = 0.05;
+
+/// A segment entry: at frame `frame`, segment `segment` started; `cut` unless it went on from
+/// its recorded predecessor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Entry {
+    /// First frame of the segment in the trace.
+    pub frame: usize,
+    /// Library segment.
+    pub segment: usize,
+    /// Whether the entry was a cut (including a segment re-entered from its own end).
+    pub cut: bool,
+}
+
+/// A motion as shown, ready to measure (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    /// Frames per second.
+    pub fps: f64,
+    /// Per frame, the hands' world positions.
+    pub hands: Vec<Vec<Vec3>>,
+    /// Per frame, the foot and toe joints' world positions (empty rows: no feet).
+    pub feet: Vec<Vec<Vec3>>,
+    /// Per frame, every joint rotation channel (degrees).
+    pub rotations: Vec<Vec<f64>>,
+    /// Segment entries in frame order (the first one at frame 0).
+    pub entries: Vec<Entry>,
+}
+
+/// The foot and toe joints of a skeleton: every joint whose name contains "foot", "toe" or
+/// "ankle" (ignoring case).
+pub fn feet(skeleton: &Skeleton) -> Vec<usize> {
+    skeleton
+        .joints
+        .iter()
+        .enumerate()
+        .filter(|(_, j)| {
+            let n = j.name.to_ascii_lowercase();
+            n.contains("foot") || n.contains("toe") || n.contains("ankle")
+        })
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// The segment entries of a playback given, per frame, the library segment and frame shown:
+/// a new entry where the segment changes or a segment starts over at frame 0. An entry is a
+/// cut unless it moves on from the last frame of a segment into its recorded successor
+/// (`continues(s)`: segment `s + 1` continues `s`; `len(s)`: frames of `s`).
+pub fn entries_from_frames(
+    shown: &[(usize, usize)],
+    continues: impl Fn(usize) -> bool,
+    len: impl Fn(usize) -> usize,
+) -> Vec<Entry> {
+    let mut out = Vec::new();
+    for (t, &(seg, frame)) in shown.iter().enumerate() {
+        let Some(&(ps, pf)) = t.checked_sub(1).and_then(|p| shown.get(p)) else {
+            out.push(Entry {
+                frame: 0,
+                segment: seg,
+                cut: false,
+            });
+            continue;
+        };
+        if seg != ps || (frame < pf && frame == 0) {
+            let on = seg == ps + 1 && continues(ps) && pf + 1 >= len(ps) && frame == 0;
+            out.push(Entry {
+                frame: t,
+                segment: seg,
+                cut: !on,
+            });
+        }
+    }
+    out
+}
+
+impl Trace {
+    /// The trace of `motion` (hands found by `hands`, feet by [`feet`]) with `entries`.
+    pub fn from_motion(
+        motion: &Motion,
+        hands: &EffectorSpec,
+        entries: Vec<Entry>,
+    ) -> Result<Self, String> {
+        let sk = motion.skeleton();
+        let eff = hands
+            .resolve(sk, motion.source())
+            .map_err(|e| e.to_string())?;
+        let fk = |targets: &[Target]| -> Result<Vec<Vec<Vec3>>, FkError> {
+            if targets.is_empty() {
+                return Ok(vec![Vec::new(); motion.frames()]);
+            }
+            let p = FkPlan::new(sk, targets)?.positions(motion)?;
+            Ok((0..p.frames()).map(|f| p.frame(f).to_vec()).collect())
+        };
+        let foot_targets: Vec<Target> = feet(sk).into_iter().map(Target::Joint).collect();
+        let rot: Vec<usize> = {
+            let mut v = Vec::new();
+            let mut k = 0;
+            for j in &sk.joints {
+                for c in &j.channels {
+                    if c.is_rotation() {
+                        v.push(k);
+                    }
+                    k += 1;
+                }
+            }
+            v
+        };
+        Ok(Self {
+            fps: motion.fps(),
+            hands: fk(&eff.targets).map_err(|e| e.to_string())?,
+            feet: fk(&foot_targets).map_err(|e| e.to_string())?,
+            rotations: (0..motion.frames())
+                .map(|f| {
+                    let row = motion.frame(f).unwrap_or(&[]);
+                    rot.iter()
+                        .map(|&k| row.get(k).copied().unwrap_or(0.0))
+                        .collect()
+                })
+                .collect(),
+            entries,
+        })
+    }
+
+    /// Frames in the trace.
+    pub fn frames(&self) -> usize {
+        self.hands.len()
+    }
+}
+
+/// The figures of one motion (see the module docs for each).
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct MotionMetrics {
+    /// Seconds of motion.
+    pub seconds: f64,
+    /// Segment entries.
+    pub entries: usize,
+    /// Distinct segments entered.
+    pub distinct_segments: usize,
+    /// `distinct_segments` over the library's segments (`None` without a library size).
+    pub library_share: Option<f64>,
+    /// Largest share of the frames one segment takes.
+    pub max_segment_share: f64,
+    /// Entropy of the segments' frame shares (bits).
+    pub usage_entropy_bits: f64,
+    /// Share of entries that enter a segment entered less than 5 s before.
+    pub repeat_5s_share: f64,
+    /// Cuts per second.
+    pub cuts_per_s: f64,
+    /// Share of frames inside whole-body still runs of at least 0.2 s.
+    pub still_share: f64,
+    /// Median foot and toe speed (units/s), `None` without feet.
+    pub foot_speed: Option<f64>,
+    /// Mean magnitude of the hands' jerk (units/s^3).
+    pub mean_jerk: f64,
+    /// Mean hand displacement across the frame of each cut (units).
+    pub jump_at_cuts: f64,
+    /// Largest hand displacement across the frame of a cut (units).
+    pub max_jump_at_cuts: f64,
+    /// 99th percentile of the hands' displacement per frame (units).
+    pub p99_step: f64,
+    /// Beat consistency with the syllable onsets (0-1).
+    pub beat_alignment: f64,
+    /// Motion beats (hand-speed minima) per second.
+    pub beats_per_s: f64,
+    /// Beat alignment of the same motion beats shifted in time (the mean over
+    /// [`CHANCE_SHIFTS`] circular shifts): what the beat density alone scores.
+    pub beat_chance: f64,
+    /// `beat_alignment - beat_chance`: how much better the beats fall on the onsets than
+    /// chance, at this beat density.
+    pub beat_lift: f64,
+    /// Hellinger distance of the hand-speed histogram to the reference (`None` without one).
+    pub hellinger: Option<f64>,
+}
+
+fn dist(a: &Vec3, b: &Vec3) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Mean hand displacement from frame `f - 1` to frame `f`.
+fn hand_step(hands: &[Vec<Vec3>], f: usize) -> f64 {
+    let (a, b) = (&hands[f - 1], &hands[f]);
+    a.iter().zip(b).map(|(x, y)| dist(x, y)).sum::<f64>() / a.len().max(1) as f64
+}
+
+/// The `q` quantile (0..=1) of `v` by nearest rank (0 for an empty slice).
+pub fn quantile(v: &[f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    s[((s.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize]
+}
+
+/// Per frame (from the second), the speed of every point (units/s).
+fn speeds(pos: &[Vec<Vec3>], fps: f64) -> Vec<Vec<f64>> {
+    pos.windows(2)
+        .map(|w| {
+            w[0].iter()
+                .zip(&w[1])
+                .map(|(a, b)| dist(a, b) * fps)
+                .collect()
+        })
+        .collect()
+}
+
+/// Normalized hand-speed histogram (see the module docs).
+pub fn speed_histogram(hands: &[Vec<Vec3>], fps: f64) -> Vec<f64> {
+    let mut h = vec![0.0; 26];
+    let mut n = 0.0;
+    for v in speeds(hands, fps).iter().flatten() {
+        h[((v / 10.0) as usize).min(25)] += 1.0;
+        n += 1.0;
+    }
+    h.iter_mut().for_each(|x| *x /= f64::max(n, 1.0));
+    h
+}
+
+/// Hellinger distance between two normalized histograms.
+pub fn hellinger(p: &[f64], q: &[f64]) -> f64 {
+    let bc: f64 = p.iter().zip(q).map(|(a, b)| (a * b).sqrt()).sum();
+    (1.0 - bc).max(0.0).sqrt()
+}
+
+/// Times (s) of motion beats: local minima of the mean hand speed smoothed over 1/6 s, so
+/// that single-frame spikes do not create beats of their own.
+pub fn motion_beats(hands: &[Vec<Vec3>], fps: f64) -> Vec<f64> {
+    let raw: Vec<f64> = speeds(hands, fps)
+        .iter()
+        .map(|v| v.iter().sum::<f64>() / v.len().max(1) as f64)
+        .collect();
+    let half = ((fps / 6.0) as usize / 2).max(1);
+    let sp: Vec<f64> = (0..raw.len())
+        .map(|i| {
+            let (a, b) = (i.saturating_sub(half), (i + half + 1).min(raw.len()));
+            raw[a..b].iter().sum::<f64>() / (b - a) as f64
+        })
+        .collect();
+    (1..sp.len().saturating_sub(1))
+        .filter(|&i| sp[i] < sp[i - 1] && sp[i] <= sp[i + 1])
+        .map(|i| (i as f64 + 0.5) / fps)
+        .collect()
+}
+
+/// Circular shifts of the motion beats behind [`MotionMetrics::beat_chance`].
+pub const CHANCE_SHIFTS: usize = 64;
+
+/// The mean beat alignment of `beats` circularly shifted over a trace of `seconds`: by
+/// `CHANCE_SHIFTS` offsets evenly spread over 0.5 s .. `seconds - 0.5` s (deterministic).
+pub fn beat_chance(onsets: &[f64], beats: &[f64], seconds: f64, sigma: f64) -> f64 {
+    if seconds <= 1.0 || beats.is_empty() {
+        return beat_alignment(onsets, beats, sigma);
+    }
+    let span = seconds - 1.0;
+    (0..CHANCE_SHIFTS)
+        .map(|k| {
+            let shift = 0.5 + span * (k as f64 + 0.5) / CHANCE_SHIFTS as f64;
+            let shifted: Vec<f64> = beats.iter().map(|b| (b + shift) % seconds).collect();
+            beat_alignment(onsets, &shifted, sigma)
+        })
+        .sum::<f64>()
+        / CHANCE_SHIFTS as f64
+}
+
+/// Beat consistency of `onsets` with `beats` (BEAT's definition, `sigma` in seconds).
+pub fn beat_alignment(onsets: &[f64], beats: &[f64], sigma: f64) -> f64 {
+    if onsets.is_empty() {
+        return 0.0;
+    }
+    onsets
+        .iter()
+        .map(|o| {
+            let d = beats
+                .iter()
+                .map(|b| (b - o).abs())
+                .fold(f64::INFINITY, f64::min);
+            if d.is_finite() {
+                (-d * d / (2.0 * sigma * sigma)).exp()
+            } else {
+                0.0
+            }
+        })
+        .sum::<f64>()
+        / onsets.len() as f64
+}
+
+/// Share of frames inside still runs (see the module docs).
+pub fn still_share(rotations: &[Vec<f64>], fps: f64) -> f64 {
+    let n = rotations.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let threshold = STILL_DEG_PER_FRAME_30FPS * 30.0 / fps.max(1e-9);
+    let min_run = (STILL_RUN_S * fps).ceil().max(1.0) as usize;
+    // still[f]: nothing moved from frame f-1 to f (frame 0 counts with frame 1).
+    let still: Vec<bool> = (0..n)
+        .map(|f| {
+            let (a, b) = if f == 0 { (0, 1) } else { (f - 1, f) };
+            rotations[a]
+                .iter()
+                .zip(&rotations[b])
+                .all(|(x, y)| (x - y).abs() <= threshold)
+        })
+        .collect();
+    let mut counted = 0usize;
+    let mut run = 0usize;
+    for (f, &s) in still.iter().enumerate() {
+        if s {
+            run += 1;
+        }
+        if !s || f + 1 == n {
+            if run >= min_run {
+                counted += run;
+            }
+            run = 0;
+        }
+    }
+    counted as f64 / n as f64
+}
+
+/// Every figure of `t` (see the module docs): `onsets` in seconds from the trace's start,
+/// `library` the library's segment count, `reference` the hand positions of the capture (and
+/// their frame rate) to compare hand speeds with.
+pub fn measure(
+    t: &Trace,
+    onsets: &[f64],
+    library: Option<usize>,
+    reference: Option<(&[Vec<Vec3>], f64)>,
+) -> MotionMetrics {
+    let n = t.frames();
+    let fps = t.fps.max(1e-9);
+    let seconds = n as f64 / fps;
+    let mut m = MotionMetrics {
+        seconds,
+        ..MotionMetrics::default()
+    };
+    if n == 0 {
+        return m;
+    }
+    // Variety: frames per segment from the entries.
+    let entries: Vec<Entry> = t.entries.iter().copied().filter(|e| e.frame < n).collect();
+    let mut frames_of: BTreeMap<usize, usize> = BTreeMap::new();
+    for (k, e) in entries.iter().enumerate() {
+        let end = entries.get(k + 1).map_or(n, |x| x.frame).max(e.frame);
+        *frames_of.entry(e.segment).or_default() += end - e.frame;
+    }
+    let covered: usize = frames_of.values().sum();
+    m.entries = entries.len();
+    m.distinct_segments = frames_of.len();
+    m.library_share = library.map(|l| m.distinct_segments as f64 / l.max(1) as f64);
+    if covered > 0 {
+        m.max_segment_share =
+            frames_of.values().copied().max().unwrap_or(0) as f64 / covered as f64;
+        m.usage_entropy_bits = -frames_of
+            .values()
+            .map(|&c| c as f64 / covered as f64)
+            .filter(|&p| p > 0.0)
+            .map(|p| p * p.log2())
+            .sum::<f64>()
+            + 0.0;
+    }
+    let window = (REPEAT_WINDOW_S * fps).round() as usize;
+    let mut last_entry: HashMap<usize, usize> = HashMap::new();
+    let mut repeats = 0usize;
+    for e in &entries {
+        if last_entry
+            .get(&e.segment)
+            .is_some_and(|&f| e.frame - f < window)
+        {
+            repeats += 1;
+        }
+        last_entry.insert(e.segment, e.frame);
+    }
+    m.repeat_5s_share = repeats as f64 / entries.len().max(1) as f64;
+    let cuts: Vec<usize> = entries
+        .iter()
+        .filter(|e| e.cut && e.frame > 0)
+        .map(|e| e.frame)
+        .collect();
+    m.cuts_per_s = cuts.len() as f64 / seconds.max(1e-9);
+    // Freezes, feet.
+    m.still_share = still_share(&t.rotations, fps);
+    let foot: Vec<f64> = speeds(&t.feet, fps).into_iter().flatten().collect();
+    m.foot_speed = (!foot.is_empty()).then(|| quantile(&foot, 0.5));
+    // Smoothness.
+    let h = &t.hands;
+    let jerk: Vec<f64> = h
+        .windows(4)
+        .flat_map(|w| {
+            (0..w[0].len()).map(move |k| {
+                let j: Vec<f64> = (0..3)
+                    .map(|c| w[3][k][c] - 3.0 * w[2][k][c] + 3.0 * w[1][k][c] - w[0][k][c])
+                    .collect();
+                (j[0] * j[0] + j[1] * j[1] + j[2] * j[2]).sqrt() * fps * fps * fps
+            })
+        })
+        .collect();
+    m.mean_jerk = jerk.iter().sum::<f64>() / jerk.len().max(1) as f64;
+    let jumps: Vec<f64> = cuts.iter().map(|&f| hand_step(h, f)).collect();
+    m.jump_at_cuts = jumps.iter().sum::<f64>() / jumps.len().max(1) as f64 + 0.0;
+    m.max_jump_at_cuts = jumps.iter().copied().fold(0.0, f64::max);
+    let steps: Vec<f64> = (1..n).map(|f| hand_step(h, f)).collect();
+    m.p99_step = quantile(&steps, 0.99);
+    // Timing and speed distribution.
+    let beats = motion_beats(h, fps);
+    m.beat_alignment = beat_alignment(onsets, &beats, 0.3);
+    m.beats_per_s = beats.len() as f64 / seconds.max(1e-9);
+    m.beat_chance = beat_chance(onsets, &beats, seconds, 0.3);
+    m.beat_lift = m.beat_alignment - m.beat_chance;
+    m.hellinger =
+        reference.map(|(r, r_fps)| hellinger(&speed_histogram(h, fps), &speed_histogram(r, r_fps)));
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn trace(frames: usize, entries: Vec<Entry>) -> Trace {
+        Trace {
+            fps: 30.0,
+            hands: (0..frames)
+                .map(|f| vec![[f as f64, 0.0, 0.0], [0.0, f as f64, 0.0]])
+                .collect(),
+            feet: vec![Vec::new(); frames],
+            rotations: (0..frames).map(|f| vec![f as f64]).collect(),
+            entries,
+        }
+    }
+
+    fn entry(frame: usize, segment: usize) -> Entry {
+        Entry {
+            frame,
+            segment,
+            cut: true,
+        }
+    }
+
+    #[test]
+    fn a_planted_loop_has_one_segment_all_the_frames_and_only_repeats() {
+        // One 30-frame segment entered every second for 10 s.
+        let t = trace(300, (0..10).map(|k| entry(30 * k, 4)).collect());
+        let m = measure(&t, &[], Some(40), None);
+        assert_eq!(m.distinct_segments, 1);
+        assert_eq!(m.library_share, Some(1.0 / 40.0));
+        assert_eq!(m.max_segment_share, 1.0);
+        assert_eq!(m.usage_entropy_bits, 0.0);
+        // Every entry but the first repeats one from a second before.
+        assert!((m.repeat_5s_share - 0.9).abs() < 1e-12);
+        assert!((m.cuts_per_s - 0.9).abs() < 1e-9);
+    }
+
+    #[test]
+    fn four_equal_segments_have_two_bits_and_repeats_only_within_5_s() {
+        // Segments 0..4 in turn, 3 s each: a segment comes back after 12 s, never within 5.
+        let t = trace(30 * 24, (0..8).map(|k| entry(90 * k, k % 4)).collect());
+        let m = measure(&t, &[], Some(8), None);
+        assert_eq!(m.distinct_segments, 4);
+        assert!((m.usage_entropy_bits - 2.0).abs() < 1e-12);
+        assert!((m.max_segment_share - 0.25).abs() < 1e-12);
+        assert_eq!(m.repeat_5s_share, 0.0);
+        // Every 2 s: repeats after 4 s (within 5).
+        let t = trace(30 * 16, (0..8).map(|k| entry(60 * k, k % 2)).collect());
+        assert!((measure(&t, &[], None, None).repeat_5s_share - 6.0 / 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_known_slide_has_its_speed_and_a_planted_foot_none() {
+        // A foot sliding 0.5 units per frame at 30 fps: 15 units/s; the other planted.
+        let mut t = trace(60, vec![entry(0, 0)]);
+        t.feet = (0..60)
+            .map(|f| vec![[0.5 * f as f64, 0.0, 0.0], [3.0, 0.0, 0.0]])
+            .collect();
+        let m = measure(&t, &[], None, None);
+        // Half the foot samples are 15, half 0: the median is one of them.
+        let s = m.foot_speed.unwrap();
+        assert!(s == 0.0 || (s - 15.0).abs() < 1e-9, "{s}");
+        t.feet = (0..60).map(|f| vec![[0.5 * f as f64, 0.0, 0.0]]).collect();
+        assert!((measure(&t, &[], None, None).foot_speed.unwrap() - 15.0).abs() < 1e-9);
+        t.feet = vec![Vec::new(); 60];
+        assert_eq!(measure(&t, &[], None, None).foot_speed, None);
+    }
+
+    #[test]
+    fn still_runs_count_only_from_a_fifth_of_a_second() {
+        // 90 frames: moving, then still for 10 frames (1/3 s), moving, still for 3 frames.
+        let mut v = 0.0;
+        let rot: Vec<Vec<f64>> = (0..90)
+            .map(|f| {
+                let still = (30..40).contains(&f) || (60..63).contains(&f);
+                if !still {
+                    v += 1.0;
+                }
+                vec![v]
+            })
+            .collect();
+        // Frames 30..40 repeat frame 29's value: 10 still frames (>= 6 at 30 fps); 60..63: 3.
+        assert!((still_share(&rot, 30.0) - 10.0 / 90.0).abs() < 1e-12);
+        // Below the threshold (0.05 deg per frame) counts as still: all of it.
+        let slow: Vec<Vec<f64>> = (0..90).map(|f| vec![0.01 * f as f64]).collect();
+        assert_eq!(still_share(&slow, 30.0), 1.0);
+    }
+
+    #[test]
+    fn jumps_at_cuts_and_the_step_percentile() {
+        // Hands move 1 unit per frame; at frame 50 (a cut) they jump 10 units.
+        let mut t = trace(100, vec![entry(0, 0), entry(50, 1)]);
+        for f in 50..100 {
+            for h in &mut t.hands[f] {
+                h[2] += 10.0;
+            }
+        }
+        let m = measure(&t, &[], None, None);
+        assert!((m.max_jump_at_cuts - (1.0f64 + 100.0).sqrt()).abs() < 1e-9);
+        assert!((m.jump_at_cuts - m.max_jump_at_cuts).abs() < 1e-12);
+        // 98 of the 99 steps are 1 unit: the 99th percentile is 1.
+        assert!((m.p99_step - 1.0).abs() < 1e-12);
+        // A continuation (not a cut) is not a jump.
+        t.entries[1].cut = false;
+        assert_eq!(measure(&t, &[], None, None).jump_at_cuts, 0.0);
+    }
+
+    #[test]
+    fn beats_on_the_onsets_score_one_and_identical_speeds_have_no_distance() {
+        // Hands that stop every second (speed minimum at each whole second).
+        let fps = 30.0;
+        let hands: Vec<Vec<Vec3>> = {
+            let mut x = 0.0;
+            (0..300)
+                .map(|f| {
+                    let t = f as f64 / fps;
+                    x += (std::f64::consts::PI * t).sin().abs() * 3.0;
+                    vec![[x, 0.0, 0.0]]
+                })
+                .collect()
+        };
+        let beats = motion_beats(&hands, fps);
+        let onsets: Vec<f64> = (1..9).map(|k| k as f64).collect();
+        assert!(beat_alignment(&onsets, &beats, 0.3) > 0.95, "{beats:?}");
+        let shifted: Vec<f64> = onsets.iter().map(|o| o + 0.5).collect();
+        assert!(beat_alignment(&shifted, &beats, 0.3) < 0.3);
+        let h = speed_histogram(&hands, fps);
+        assert!((h.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        assert_eq!(hellinger(&h, &h), 0.0);
+    }
+
+    #[test]
+    fn entries_come_from_segment_changes_and_restarts() {
+        // Segment 0 (3 frames) runs on into its successor 1; 1 is cut into 5; 5 restarts.
+        let shown = [
+            (0, 0),
+            (0, 1),
+            (0, 2),
+            (1, 0),
+            (1, 1),
+            (5, 0),
+            (5, 1),
+            (5, 0),
+            (5, 1),
+        ];
+        let e = entries_from_frames(&shown, |s| s == 0, |_| 3);
+        let got: Vec<(usize, usize, bool)> =
+            e.iter().map(|e| (e.frame, e.segment, e.cut)).collect();
+        assert_eq!(
+            got,
+            [(0, 0, false), (3, 1, false), (5, 5, true), (7, 5, true)]
+        );
+        // Entering the successor from the middle of a segment is a cut.
+        let shown = [(0, 0), (1, 0)];
+        assert!(entries_from_frames(&shown, |_| true, |_| 3)[1].cut);
+    }
+
+    #[test]
+    fn an_empty_trace_is_all_zero() {
+        let m = measure(&Trace::default(), &[1.0], Some(3), None);
+        assert_eq!(m.entries, 0);
+        assert_eq!(m.seconds, 0.0);
+    }
+}
