@@ -91,6 +91,19 @@ pub enum Command {
         #[arg(long, value_name = "DIR", default_value = "gesture-demo")]
         out: PathBuf,
     },
+    /// The motion-quality figures of a `run` output folder (motion.bvh and timeline.json):
+    /// variety, freezes, feet, jerk, jumps at cuts, beats.
+    Metrics {
+        /// The folder `gesture-sim run --out` wrote.
+        #[arg(value_name = "DIR")]
+        dir: PathBuf,
+        /// A motion capture to compare the hands' speeds with (Hellinger distance).
+        #[arg(long, value_name = "BVH")]
+        mocap: Option<PathBuf>,
+        /// Print one JSON object instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// List the audio input devices.
     Devices,
     /// Run a policy blob on the microphone, printing decisions and the belief.
@@ -152,6 +165,9 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             out,
         ),
         Command::Devices => Ok(live::devices(out)?),
+        Command::Metrics { dir, mocap, json } => {
+            crate::metrics_cmd::run(dir, mocap.as_ref(), *json, out)
+        }
         Command::Demo { out: dir } => Ok(crate::demo::demo(
             dir,
             crate::demo::DemoParams::default(),

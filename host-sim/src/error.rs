@@ -49,6 +49,9 @@ pub enum SimError {
     /// `demo` failed.
     #[error(transparent)]
     Demo(#[from] crate::demo::DemoError),
+    /// `metrics` could not read or measure a run folder.
+    #[error("{0}")]
+    Metrics(String),
 }
 
 impl From<RunError> for SimError {
@@ -66,6 +69,7 @@ impl SimError {
             Self::Run(e) => e.exit_code(),
             Self::Live(e) => e.exit_code(),
             Self::Demo(e) => e.exit_code(),
+            Self::Metrics(_) => 2,
         }
     }
 }

@@ -16,6 +16,7 @@
 //! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
 //! - [`run`](mod@run): `gesture-sim run`: a WAV file through the runtime's device loop, with
 //!   BVH, timeline, servo trace and previews written to a folder.
+//! - [`metrics_cmd`]: `gesture-sim metrics`: the motion-quality figures of a `run` folder.
 //! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
 //!   [`live::AudioSource`] trait, with a fake source for tests.
 //! - [`error`]: [`error::SimError`], the error of every command, and its exit status.
@@ -31,6 +32,7 @@ pub mod error;
 pub mod eval;
 pub mod eval_cmd;
 pub mod live;
+pub mod metrics_cmd;
 pub mod prosody_cmd;
 pub mod run;
 pub mod servo;

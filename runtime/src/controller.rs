@@ -49,8 +49,10 @@ pub struct DecisionTiming {
     pub sync_to_onsets: bool,
     /// An onset detected this recently (ms) counts as "now".
     pub onset_window_ms: u32,
-    /// Longest hold (ms) at a segment's end while waiting for an onset.
+    /// Longest wait (ms) at a segment's end for an onset (running on meanwhile).
     pub max_wait_ms: u32,
+    /// Longest hold (ms) at a motion beat waiting for an onset (0: no holds).
+    pub beat_hold_ms: u32,
 }
 
 impl DecisionTiming {
@@ -60,12 +62,14 @@ impl DecisionTiming {
         sync_to_onsets: true,
         onset_window_ms: 50,
         max_wait_ms: 300,
+        beat_hold_ms: 0,
     };
     /// Every exit point decides as soon as it is reached.
     pub const IMMEDIATE: Self = Self {
         sync_to_onsets: false,
         onset_window_ms: 0,
         max_wait_ms: 0,
+        beat_hold_ms: 0,
     };
 }
 
@@ -192,7 +196,9 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     variety: Variety,
     history: History,
     /// Belief the policy decides with instead of the CRF's (an evaluation's ablation).
-    held: Option<[f32; MAX_STATES]>,
+    held_belief: Option<[f32; MAX_STATES]>,
+    /// Ticks held at the current motion beat, waiting for an onset.
+    holding: u64,
     /// Tick at which the last onset was detected (the tick due next when it arrived).
     last_onset: Option<u64>,
     /// The end exit the controller is waiting at for an onset, running on meanwhile.
@@ -248,7 +254,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             timing: DecisionTiming::DEFAULT,
             variety: Variety::NONE,
             history: History::new(),
-            held: None,
+            held_belief: None,
+            holding: 0,
             last_onset: None,
             waiting: None,
             waited: 0,
@@ -304,7 +311,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
     /// ignores it. For evaluations (the "belief held at the prior" ablation); a `belief` of
     /// another length is ignored.
     pub fn hold_belief(&mut self, belief: Option<&[f32]>) {
-        self.held = belief.filter(|b| b.len() == self.tables.states()).map(|b| {
+        self.held_belief = belief.filter(|b| b.len() == self.tables.states()).map(|b| {
             let mut h = [0.0; MAX_STATES];
             h[..b.len()].copy_from_slice(b);
             h
@@ -421,7 +428,19 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
 
     fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
         let segment = self.player.segment();
-        let played = self.player.tick(self.lib, &mut self.pose);
+        let t = self.timing;
+        let fresh = !t.sync_to_onsets
+            || self.last_onset.is_some_and(|o| {
+                !self.ticks_reach_ms(self.ticks.saturating_sub(o), t.onset_window_ms)
+            });
+        // At a motion beat, hold the frame until an onset (for at most beat_hold_ms), so the
+        // hands' pauses fall on syllables.
+        let at_beat = t.sync_to_onsets
+            && t.beat_hold_ms > 0
+            && self.lib.is_beat(segment, self.player.frame());
+        let hold = at_beat && !fresh && !self.ticks_reach_ms(self.holding + 1, t.beat_hold_ms);
+        self.holding = if hold { self.holding + 1 } else { 0 };
+        let played = self.player.tick_advancing(self.lib, &mut self.pose, !hold);
         let tick = self.ticks;
         self.ticks += 1;
         if self.ticks == 1 {
@@ -489,7 +508,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             self.ms_ticks(self.variety.usage_ms),
         );
         let s = self.tables.states();
-        let decision = match &self.held {
+        let decision = match &self.held_belief {
             Some(h) => select(self.tables, e, &h[..s], &penalties),
             None => select(self.tables, e, self.belief(), &penalties),
         };

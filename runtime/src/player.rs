@@ -56,6 +56,10 @@ pub trait LibraryFrames {
     fn continues(&self, _c: usize) -> bool {
         false
     }
+    /// Whether frame `f` of segment `c` is a motion beat (the hands' speed at a minimum).
+    fn is_beat(&self, _c: usize, _f: usize) -> bool {
+        false
+    }
     /// Rotation groups (three channels holding one rotation as Euler angles).
     fn group_count(&self) -> usize {
         0
@@ -222,6 +226,17 @@ impl Player {
         lib: &L,
         out: &mut [f32; MAX_CHANNELS],
     ) -> usize {
+        self.tick_advancing(lib, out, true)
+    }
+
+    /// [`tick`](Self::tick), staying on the same frame when `advance` is false (a hold; a
+    /// blend in progress goes on).
+    pub fn tick_advancing<L: LibraryFrames + ?Sized>(
+        &mut self,
+        lib: &L,
+        out: &mut [f32; MAX_CHANNELS],
+        advance: bool,
+    ) -> usize {
         let n = lib.channels().min(MAX_CHANNELS);
         let len = lib.segment_len(self.segment).max(1);
         let f = self.frame.min(len - 1);
@@ -271,7 +286,7 @@ impl Player {
             self.last[ch] = *o;
         }
         self.outputs = self.outputs.saturating_add(1);
-        if self.frame + 1 < len {
+        if advance && self.frame + 1 < len {
             self.frame += 1;
         }
         f

@@ -288,6 +288,14 @@ fn every_error_variant_is_reachable() {
         },
     );
     check(
+        &mutated(&|t| t.beats = vec![]),
+        BlobError::TableLength {
+            field: Field::Beats,
+            expected: 1,
+            found: 0,
+        },
+    );
+    check(
         &mutated(&|t| t.groups = vec![0, 0]),
         BlobError::TableLength {
             field: Field::Groups,
@@ -481,6 +489,12 @@ fn every_error_variant_is_reachable() {
         &mutated(&|t| t.control.blend_ms = 5001),
         BlobError::BadControl {
             field: Field::Blend,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.beat_hold_ms = 1001),
+        BlobError::BadControl {
+            field: Field::BeatHold,
         },
     );
 

@@ -59,7 +59,7 @@ fn constructors_round_trip_through_the_reader() {
         })
         .collect();
     // Channels 0..3 hold one rotation (Z, Y, X: EULER_ORDERS index 5).
-    let library = OwnedLibrary::new(25.0, 3, &frames, &segs, &[(0, 5)]).unwrap();
+    let library = OwnedLibrary::new(25.0, 3, &frames, &segs, &[3, 17], &[(0, 5)]).unwrap();
     // Exits: an interruption at frame 2 of every segment and the end at frame 4.
     let exits: Vec<(usize, usize)> = (0..4).flat_map(|s| [(s, 2), (s, 4)]).collect();
     // End exits: two successors sorted by segment; interruptions: none.
@@ -97,6 +97,7 @@ fn constructors_round_trip_through_the_reader() {
         sync_to_onsets: false,
         onset_window_ms: 0,
         max_wait_ms: 120,
+        beat_hold_ms: 90,
     };
     let variety = Variety {
         recency_cost: 1.25,
@@ -123,6 +124,8 @@ fn constructors_round_trip_through_the_reader() {
     assert_eq!(b.variety(), variety);
     assert_eq!(b.blend_ms(), 200);
     assert!(b.continues(0) && b.continues(2) && !b.continues(3));
+    let beats: Vec<usize> = (0..20).filter(|&f| b.is_beat_frame(f)).collect();
+    assert_eq!(beats, [3, 17]);
     assert_eq!((b.group_count(), b.group(0)), (1, Some((0, [2, 1, 0]))));
     // Frames come back within half a quantization step of each channel's range.
     for (f, fr) in frames.iter().enumerate() {
@@ -192,9 +195,9 @@ fn builder_errors_are_typed() {
     })
     .unwrap_err();
     assert!(matches!(e, EncodeError::Inconsistent(_)), "{e}");
-    let e = OwnedLibrary::new(30.0, 2, &[vec![1.0]], &[], &[]).unwrap_err();
+    let e = OwnedLibrary::new(30.0, 2, &[vec![1.0]], &[], &[], &[]).unwrap_err();
     assert!(e.to_string().contains("1 values for 2 channels"), "{e}");
-    let e = OwnedLibrary::new(30.0, 1, &[vec![f32::NAN]], &[], &[]).unwrap_err();
+    let e = OwnedLibrary::new(30.0, 1, &[vec![f32::NAN]], &[], &[], &[]).unwrap_err();
     assert!(matches!(e, EncodeError::Inconsistent(_)));
     let e = OwnedRig::new("r", 20_000.0, &[("a\nb".into(), ChannelCal::HOBBY)]).unwrap_err();
     assert!(e.to_string().contains("newline"), "{e}");

@@ -1,13 +1,14 @@
 //! The control layer end to end: the packed blob's bytes through the runtime's controller
 //! (quantized inference and policy) against the trainer's float, unpruned policy on real
-//! audio from another speaker.
+//! audio from another speaker; and the motion-quality requirements of the online controller
+//! on held-out speech.
 
 use std::path::PathBuf;
 
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::{BlobController, ControllerEvent, DecisionTiming};
 use gesture_runtime::inference::StepNormalizer;
-use gesture_runtime::policy::Choice;
+use gesture_runtime::policy::{Choice, Variety};
 use gesture_runtime::prosody::{ProsodyConfig, StepKind};
 use gesture_trainer::control::Action;
 use gesture_trainer::corpus::{load_corpus, LoadOptions};
@@ -30,10 +31,14 @@ fn runtime_decisions_agree_with_the_float_policy_on_another_speaker() {
     let corpus = load_corpus(std::slice::from_ref(&ze), &LoadOptions::default()).unwrap();
     let (seqs, segs) = sequences(&corpus, None);
     let (model, _) = fit(&seqs, &segs, &FitConfig::default(), &|_| {}).unwrap();
+    // The pure decision rule (no variety costs: those depend on the history of entries and
+    // are compared host against device by the QEMU check): what quantization and pruning
+    // change is measured here.
     let mut packed = Vec::new();
     for timing in [DecisionTiming::DEFAULT, DecisionTiming::IMMEDIATE] {
         let opts = PackOptions {
             timing,
+            variety: Variety::NONE,
             ..PackOptions::default()
         };
         packed.push(pack_model(&model, &[ze.join("067_Speech_2_first50s.bvh")], &opts).unwrap());
@@ -124,14 +129,15 @@ struct EvalCli {
     args: gesture_trainer::cli::eval_motion::EvalMotionArgs,
 }
 
-/// The motion-quality requirement of the control layer, with the command-line defaults: a model fitted
-/// on ZeroEGGS 0-40 s, the take's own library, the device's online controller (quantized,
-/// decisions on syllable onsets) against random selection from the same library, on held-out
-/// speech: ZeroEGGS 40-50 s and both beat-scott monologues (another speaker).
+/// The motion-quality requirements, with the command-line defaults: a model fitted on ZeroEGGS
+/// 0-40 s and the take's own library, played by the device's online controller (the packed
+/// blob, decisions on syllable onsets) on speech neither saw: the take's last 10 s (against
+/// its own capture) and both beat-scott monologues (another speaker, 2 minutes).
 #[test]
-fn online_controller_beats_random_on_jumps_and_beat_alignment_on_held_out_speech() {
+fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
     use clap::Parser;
-    let Some(d) = data("online_controller_beats_random_on_jumps_and_beat_alignment") else {
+    let Some(d) = data("online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech")
+    else {
         return;
     };
     let ze = d.join("zeroeggs-067-speech2");
@@ -154,22 +160,7 @@ fn online_controller_beats_random_on_jumps_and_beat_alignment_on_held_out_speech
         scott.join("2_scott_0_1_1.wav"),
         scott.join("2_scott_0_2_2.wav"),
     );
-    let cases: Vec<(Vec<&std::ffi::OsStr>, &str)> = vec![
-        (
-            vec![
-                "--audio".as_ref(),
-                wav.as_os_str(),
-                "--mocap".as_ref(),
-                bvh.as_os_str(),
-                "--span".as_ref(),
-                "40:50".as_ref(),
-            ],
-            "zeroeggs 40-50 s",
-        ),
-        (vec!["--audio".as_ref(), s1.as_os_str()], "2_scott_0_1_1"),
-        (vec!["--audio".as_ref(), s2.as_os_str()], "2_scott_0_2_2"),
-    ];
-    for (extra, name) in cases {
+    let eval = |extra: Vec<&std::ffi::OsStr>| {
         let mut argv: Vec<&std::ffi::OsStr> = vec![
             "eval-motion".as_ref(),
             "--model".as_ref(),
@@ -178,30 +169,62 @@ fn online_controller_beats_random_on_jumps_and_beat_alignment_on_held_out_speech
             ze.as_os_str(),
         ];
         argv.extend(extra);
-        let rows =
-            gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap();
-        let get = |m: &str| rows.rows.iter().find(|r| r.method == m).unwrap().metrics;
-        let (online, random) = (get("online"), get("random"));
-        eprintln!(
-            "{name}: jump at cuts {:.2} vs random {:.2}; beat alignment {:.3} vs random {:.3}; \
-             cuts/s {:.2} vs {:.2}",
-            online.jump_at_cuts,
-            random.jump_at_cuts,
-            online.beat_alignment,
-            random.beat_alignment,
-            online.cuts_per_s,
-            random.cuts_per_s
-        );
-        // The online controller must make cuts (following the recorded order would win on
-        // jumps by never cutting), and make them smaller than random ones.
-        assert!(online.cuts_per_s > 0.1, "{name}: {online:?}");
-        assert!(
-            online.jump_at_cuts < random.jump_at_cuts,
-            "{name}: {online:?} vs {random:?}"
-        );
-        assert!(
-            online.beat_alignment > random.beat_alignment,
-            "{name}: {online:?} vs {random:?}"
-        );
-    }
+        gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap()
+    };
+    let get = |rows: &gesture_trainer::evaluate::motion::Evaluation, m: &str| {
+        rows.rows.iter().find(|r| r.method == m).unwrap().metrics
+    };
+
+    // Against the capture of the same speech.
+    let own = eval(vec![
+        "--audio".as_ref(),
+        wav.as_os_str(),
+        "--mocap".as_ref(),
+        bvh.as_os_str(),
+        "--span".as_ref(),
+        "40:50".as_ref(),
+    ]);
+    let (online, mocap) = (get(&own, "online"), get(&own, "mocap"));
+    eprintln!("zeroeggs 40-50 s: online {online:?}\nmocap {mocap:?}");
+    assert!(
+        (online.still_share - mocap.still_share).abs() <= 0.02,
+        "still {} vs capture {}",
+        online.still_share,
+        mocap.still_share
+    );
+    let (foot, foot_cap) = (online.foot_speed.unwrap(), mocap.foot_speed.unwrap());
+    assert!(
+        foot <= f64::max(2.0, 3.0 * foot_cap),
+        "feet {foot} vs {foot_cap}"
+    );
+    assert!(
+        online.mean_jerk <= 1.5 * mocap.mean_jerk,
+        "jerk {} vs capture {}",
+        online.mean_jerk,
+        mocap.mean_jerk
+    );
+    // No frame-to-frame jump at a cut beyond what the capture itself shows.
+    assert!(
+        online.max_jump_at_cuts <= mocap.p99_step,
+        "largest jump at a cut {} vs the capture's 99th percentile step {}",
+        online.max_jump_at_cuts,
+        mocap.p99_step
+    );
+
+    // Two minutes of another speaker.
+    let other = eval(vec!["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()]);
+    let (online, random) = (get(&other, "online"), get(&other, "random"));
+    eprintln!("beat-scott: online {online:?}\nrandom {random:?}");
+    assert!(online.seconds > 120.0, "{}", online.seconds);
+    assert!(online.library_share.unwrap() >= 0.5, "{online:?}");
+    assert!(online.max_segment_share <= 0.15, "{online:?}");
+    assert!(online.repeat_5s_share <= 0.10, "{online:?}");
+    assert!(online.still_share <= 0.02, "{online:?}");
+    // The controller must make cuts (following the recorded order would win on jumps by never
+    // cutting), and make them smaller than random ones.
+    assert!(online.cuts_per_s > 0.1, "{online:?}");
+    assert!(
+        online.jump_at_cuts <= random.jump_at_cuts,
+        "{online:?} vs {random:?}"
+    );
 }

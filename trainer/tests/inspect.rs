@@ -45,19 +45,22 @@ fn summarizes_a_valid_blob() {
     let text = String::from_utf8(out.stdout).unwrap();
     for want in [
         format!(
-            "blob: {n} bytes, format version 3, flags 0x0000, payload {} bytes",
+            "blob: {n} bytes, format version 4, flags 0x0000, payload {} bytes",
             n - 16
         ),
         "sections (bytes): front_end ".to_string(),
         "front_end: 16000 Hz, pitch 75-600 Hz".to_string(),
         "control: decisions on syllable onsets (within 50 ms; a segment end waits up to 300 ms)"
             .to_string(),
+        "variety: recency cost 0 over 0 ms, usage cost 0 over 0 ms; cuts blended over 0 ms; \
+         beat hold 0 ms"
+            .to_string(),
         "inference: 2 states, 1 clusters, window 1".to_string(),
         "policy: 2 segments, 3 exit points (2 end, 1 interruption), 4 successor entries \
          (1.33 per exit point), discount 0.9"
             .to_string(),
         "library: 2 segments, 6 frames, 1 channels, 30 fps (0.20 s of frames), 1 with a \
-         stroke, 1 labelled"
+         stroke, 1 labelled, 0 run on into their recorded successor, 0 rotation groups"
             .to_string(),
         "rig: \"example\", PWM period 20000 us, 1 channels: head".to_string(),
     ] {

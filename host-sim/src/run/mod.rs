@@ -39,6 +39,7 @@ use gesture_trainer::audio::{load_wav_at, AudioError};
 use gesture_trainer::motion::write_bvh;
 use gesture_trainer::rig::{Rig, RigError};
 
+use gesture_trainer::evaluate::metrics::entries_from_frames;
 use gesture_trainer::rig::PoseSkeleton;
 use sim::{median_max, simulate, SimOptions, Simulation};
 
@@ -326,6 +327,11 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
             segments: blob.segments(),
             exit_points: blob.exit_points(),
             chunk_s: chunk as f64 / rate as f64,
+            entries: &entries_from_frames(
+                &sim.shown,
+                |s| blob.continues(s),
+                |s| blob.segment(s).map_or(1, |x| x.len as usize),
+            ),
         },
     )?;
     let written = write_all(&cfg.out, &outputs.files)?;

@@ -104,6 +104,8 @@ pub struct Simulation {
     pub decisions: Vec<DecisionRecord>,
     /// One pose per tick (rig channel values, degrees).
     pub poses: Vec<Vec<f32>>,
+    /// Per tick, the library segment and frame shown.
+    pub shown: Vec<(usize, usize)>,
     /// One row of duty cycles per tick, from the virtual servo rig.
     pub duties: Vec<Vec<u16>>,
     /// Wall-clock time of the simulation (s).
@@ -256,7 +258,15 @@ fn record(
                 cost: decision.cost,
             })
         }
-        ControllerEvent::Pose { pose, .. } => sim.poses.push(pose.to_vec()),
+        ControllerEvent::Pose {
+            pose,
+            segment,
+            frame,
+            ..
+        } => {
+            sim.poses.push(pose.to_vec());
+            sim.shown.push((segment, frame));
+        }
         ControllerEvent::Onset(_) => {}
     }
 }

@@ -1,7 +1,7 @@
 //! `timeline.json`: what the controller heard, believed and chose, in time order.
 //!
 //! ```text
-//! { "format": "gesture-sim-timeline", "version": 1,
+//! { "format": "gesture-sim-timeline", "version": 2,
 //!   "audio": PATH, "blob": PATH, "sample_rate_hz", "fps", "duration_s", "ticks",
 //!   "states", "segments", "exit_points", "chunk_s",
 //!   "steps": [ { "kind": "syllable" | "pause", "start_s", "end_s", "f0_hz" (null when
@@ -10,6 +10,7 @@
 //!   "decisions": [ { "time_s", "tick", "exit", "exit_segment", "exit_frame",
 //!                    "choice": "continue" | "enter", "segment" (entered, or null),
 //!                    "candidates", "cost" } ],
+//!   "entries": [ { "tick", "time_s", "segment", "cut" } ],
 //!   "latency": { "syllables", "median_s", "max_s" } }
 //! ```
 //!
@@ -17,12 +18,15 @@
 //! the end of the audio chunk whose processing reported the step (see `run::sim`);
 //! `latency_s = detected_s - end_s`; `flushed` steps were closed by the end of the audio and
 //! have no latency. `belief` is the CRF forward belief after the step. The `latency` summary
-//! is over the syllables that are not flushed.
+//! is over the syllables that are not flushed. `entries` are the segment entries as shown
+//! (a new segment, or one started over): `cut` unless the body moved on from a segment's last
+//! frame into its recorded successor; `gesture-sim metrics` reads them with `motion.bvh`.
 
 use serde::Serialize;
 
 use super::sim::{median_max, Simulation};
 use gesture_runtime::prosody::StepKind;
+use gesture_trainer::evaluate::metrics::Entry;
 
 /// The whole file.
 #[derive(Debug, Serialize)]
@@ -41,7 +45,21 @@ pub struct Timeline<'a> {
     chunk_s: f64,
     steps: Vec<Step>,
     decisions: Vec<Decision>,
+    entries: Vec<EntryRecord>,
     latency: Latency,
+}
+
+/// One segment entry as written.
+#[derive(Debug, Serialize, serde::Deserialize, Clone, Copy, PartialEq)]
+pub struct EntryRecord {
+    /// Animation tick of the segment's first frame shown.
+    pub tick: usize,
+    /// Its time (s).
+    pub time_s: f64,
+    /// Library segment.
+    pub segment: usize,
+    /// Whether it was a cut.
+    pub cut: bool,
 }
 
 #[derive(Debug, Serialize)]
@@ -93,6 +111,8 @@ pub struct Context<'a> {
     pub exit_points: usize,
     /// Chunk length (s).
     pub chunk_s: f64,
+    /// Segment entries.
+    pub entries: &'a [Entry],
 }
 
 /// Rounds to 6 decimals so the file stays readable (microsecond times).
@@ -107,7 +127,7 @@ impl<'a> Timeline<'a> {
         let mm = median_max(&lat);
         Self {
             format: "gesture-sim-timeline",
-            version: 1,
+            version: 2,
             audio: cx.audio,
             blob: cx.blob,
             sample_rate_hz: sim.sample_rate_hz,
@@ -154,6 +174,16 @@ impl<'a> Timeline<'a> {
                     segment: d.entered,
                     candidates: d.candidates,
                     cost: d.cost,
+                })
+                .collect(),
+            entries: cx
+                .entries
+                .iter()
+                .map(|e| EntryRecord {
+                    tick: e.frame,
+                    time_s: r6(e.frame as f64 / sim.fps.max(1e-9)),
+                    segment: e.segment,
+                    cut: e.cut,
                 })
                 .collect(),
             latency: Latency {

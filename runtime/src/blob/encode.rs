@@ -359,6 +359,8 @@ pub struct OwnedLibrary {
     pub labels: Vec<u8>,
     /// `u8` per segment.
     pub continues: Vec<u8>,
+    /// Beat bitset over the frame table.
+    pub beats: Vec<u8>,
     /// Rotation-group records.
     pub groups: Vec<u8>,
 }
@@ -378,19 +380,22 @@ impl OwnedLibrary {
             strokes: &self.strokes,
             labels: &self.labels,
             continues: &self.continues,
+            beats: &self.beats,
             groups: &self.groups,
         }
     }
 
     /// Quantizes `frames` (one `Vec` of channel values in degrees per frame, all of length
     /// `channels`) per channel over its range ([`quantize_range`]: error at most half a step,
-    /// range / 65534), and lays out `segments` and the rotation `groups` (first channel, Euler
-    /// order as an [`EULER_ORDERS`](super::EULER_ORDERS) index).
+    /// range / 65534), and lays out `segments`, the motion `beats` (frame indices) and the
+    /// rotation `groups` (first channel, Euler order as an
+    /// [`EULER_ORDERS`](super::EULER_ORDERS) index).
     pub fn new(
         fps: f64,
         channels: usize,
         frames: &[Vec<f32>],
         segments: &[SegmentSpec],
+        beats: &[usize],
         groups: &[(usize, u8)],
     ) -> Result<Self, EncodeError> {
         if let Some((i, f)) = frames.iter().enumerate().find(|(_, f)| f.len() != channels) {
@@ -444,6 +449,15 @@ impl OwnedLibrary {
             strokes,
             labels: segments.iter().map(|s| s.label).collect(),
             continues: segments.iter().map(|s| s.continues as u8).collect(),
+            beats: {
+                let mut bits = alloc::vec![0u8; frames.len().div_ceil(8)];
+                for &f in beats {
+                    if let Some(b) = bits.get_mut(f / 8) {
+                        *b |= 1 << (f % 8);
+                    }
+                }
+                bits
+            },
             groups: groups
                 .iter()
                 .map(|&(first, order)| {
@@ -700,6 +714,7 @@ impl OwnedPayload {
             1,
             &frames,
             &[seg(0, None, 0), seg(3, Some(1), 2)],
+            &[],
             &[],
         );
         let rig = OwnedRig::new("example", 20_000.0, &[("head".into(), ChannelCal::HOBBY)]);

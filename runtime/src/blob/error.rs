@@ -89,6 +89,8 @@ pub enum Field {
     Usage,
     /// `control.blend_ms`.
     Blend,
+    /// `control.beat_hold_ms`.
+    BeatHold,
     /// `library.channels`.
     Channels,
     /// `library.frames`.
@@ -107,6 +109,8 @@ pub enum Field {
     Labels,
     /// `library.continues`.
     Continues,
+    /// `library.beats`.
+    Beats,
     /// `library.groups`.
     Groups,
     /// `rig.calibration`.
@@ -153,6 +157,7 @@ impl Field {
             Self::Recency => "control.recency_cost",
             Self::Usage => "control.usage_cost",
             Self::Blend => "control.blend_ms",
+            Self::BeatHold => "control.beat_hold_ms",
             Self::Channels => "library.channels",
             Self::Frames => "library.frames",
             Self::SegStart => "library.seg_start",
@@ -162,6 +167,7 @@ impl Field {
             Self::Strokes => "library.strokes",
             Self::Labels => "library.labels",
             Self::Continues => "library.continues",
+            Self::Beats => "library.beats",
             Self::Groups => "library.groups",
             Self::Calibration => "rig.calibration",
             Self::Joints => "skeleton.joints",

@@ -85,3 +85,5 @@ pub const MAX_WAIT_MS: u16 = 5000;
 pub const MAX_VARIETY_COST: f32 = 1.0e6;
 /// Longest inertialization time of the `control` section (ms).
 pub const MAX_BLEND_MS: u16 = 5000;
+/// Longest hold at a motion beat of the `control` section (ms).
+pub const MAX_BEAT_HOLD_MS: u16 = 1000;

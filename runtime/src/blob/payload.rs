@@ -222,6 +222,8 @@ pub struct ControlSection {
     pub usage_ms: u16,
     /// Inertialization time at cuts (ms): the pose offset decays over this time.
     pub blend_ms: u16,
+    /// Longest hold at a motion beat waiting for a syllable onset (ms; 0: no holds).
+    pub beat_hold_ms: u16,
 }
 
 impl ControlSection {
@@ -242,6 +244,7 @@ impl ControlSection {
             usage_cost: v.usage_cost,
             usage_ms: ms(v.usage_ms),
             blend_ms: ms(blend_ms),
+            beat_hold_ms: ms(t.beat_hold_ms),
         }
     }
 }
@@ -279,6 +282,10 @@ pub struct LibrarySection<'a> {
     /// stored right after it), else 0.
     #[serde(borrow)]
     pub continues: &'a [u8],
+    /// Motion beats: a bit per frame of the frame table (bit `f % 8` of byte `f / 8`), set on
+    /// the frames where the hands' speed has a local minimum.
+    #[serde(borrow)]
+    pub beats: &'a [u8],
     /// Rotation groups: records `{first: u16, order: u8}`, three channels
     /// `first..first + 3` holding one joint rotation as Euler angles in that order
     /// ([`EULER_ORDERS`](super::EULER_ORDERS) index), blended as rotations; sorted, disjoint.

@@ -58,6 +58,10 @@ impl LibraryFrames for Blob<'_> {
     fn continues(&self, c: usize) -> bool {
         Blob::continues(self, c)
     }
+    fn is_beat(&self, c: usize, f: usize) -> bool {
+        self.segment(c)
+            .is_some_and(|s| f < s.len as usize && self.is_beat_frame(s.start as usize + f))
+    }
     fn group_count(&self) -> usize {
         Blob::group_count(self)
     }

@@ -351,6 +351,7 @@ impl<'a> Blob<'a> {
             sync_to_onsets: c.sync_to_onsets != 0,
             onset_window_ms: c.onset_window_ms as u32,
             max_wait_ms: c.max_wait_ms as u32,
+            beat_hold_ms: c.beat_hold_ms as u32,
         }
     }
 
@@ -403,6 +404,15 @@ impl<'a> Blob<'a> {
     /// successor); false out of range.
     pub fn continues(&self, s: usize) -> bool {
         self.payload.library.continues.get(s) == Some(&1)
+    }
+
+    /// Whether frame `f` of the frame table is a motion beat (false out of range).
+    pub fn is_beat_frame(&self, f: usize) -> bool {
+        self.payload
+            .library
+            .beats
+            .get(f / 8)
+            .is_some_and(|b| b & (1 << (f % 8)) != 0)
     }
 
     /// Rotation groups (records of `library.groups`).

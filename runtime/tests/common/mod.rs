@@ -65,6 +65,7 @@ pub struct Tiny {
     pub strokes: Vec<u8>,
     pub labels: Vec<u8>,
     pub continues: Vec<u8>,
+    pub beats: Vec<u8>,
     pub groups: Vec<u8>,
     pub rig_name: String,
     pub period_us: f32,
@@ -159,6 +160,7 @@ impl Tiny {
                 usage_cost: 4.0,
                 usage_ms: 30000,
                 blend_ms: 250,
+                beat_hold_ms: 150,
             },
             channels: 1,
             fps: 30.0,
@@ -171,6 +173,7 @@ impl Tiny {
             strokes: le_u16(&[NO_STROKE, 1]),
             labels: vec![0, 2],
             continues: vec![1, 0],
+            beats: vec![0b0001_0010],
             groups: vec![],
             rig_name: "tiny".into(),
             period_us: 20_000.0,
@@ -223,6 +226,7 @@ impl Tiny {
                 strokes: &self.strokes,
                 labels: &self.labels,
                 continues: &self.continues,
+                beats: &self.beats,
                 groups: &self.groups,
             },
             rig: RigSection {
@@ -267,11 +271,12 @@ pub fn hex(b: &[u8]) -> String {
 }
 
 /// The tiny blob's bytes (format version 4: the `control` section after
-/// `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01`; the library
-/// ends with `continues` `02 01 00` and no `groups`, `00`). Changing the format changes
+/// `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601`; the
+/// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4) and no `groups`,
+/// `00`). Changing the format changes
 /// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(
-    "4753544204000000c6010000dd463b00",
+    "4753544204000000ca010000699bff2a",
     "807d00009642000016448fc2f53c6666e63e0ad7233c3333b33e295c0f3e0000",
     "00400000c8410000c84100008c42061902010134000000bf000080bf0000803e",
     "0000c0bf000000400000003f000080400000a0bf0000003e0000003f000080be",
@@ -279,14 +284,14 @@ pub const GOLDEN: &str = concat!(
     "033b04f4010cfe0202036666663f0000003f080a0014001e0028000000803e0c",
     "0100020003000400050006000c00000200010001000100020010000000000200",
     "0000020000000400000010000005000100fbff0000070001000000cdcccc3d01",
-    "32ac020000c03f882700008040b0ea01fa01010000f041060208000000000300",
-    "00000403000300080ad7233c000020410c00006400c8002c019cff38ff04ffff",
-    "0100020002020100000474696e7900409c461c000000000000b4c20000b44200",
-    "00803f0080bb440000204100007a430468656164010209686970730a68656164",
-    "04ffff0000180000000000000000000000000000000000002041000000000206",
-    "030900010205030405030424000000000000b442000000000000000000000000",
-    "000000000000000000000000000000000e0100000000000000a0400000000006",
-    "010001000101",
+    "32ac020000c03f882700008040b0ea01fa019601010000f04106020800000000",
+    "030000000403000300080ad7233c000020410c00006400c8002c019cff38ff04",
+    "ffff01000200020201000112000474696e7900409c461c000000000000b4c200",
+    "00b4420000803f0080bb440000204100007a430468656164010209686970730a",
+    "6865616404ffff00001800000000000000000000000000000000000020410000",
+    "00000206030900010205030405030424000000000000b4420000000000000000",
+    "00000000000000000000000000000000000000000e0100000000000000a04000",
+    "00000006010001000101",
 );
 
 pub fn postcard_len<T: serde::Serialize>(v: &T) -> usize {

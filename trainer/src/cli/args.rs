@@ -144,6 +144,10 @@ pub struct DeviceArgs {
     /// Longest wait for an onset at a segment's end (ms; the body runs on meanwhile).
     #[arg(long, default_value_t = DecisionTiming::DEFAULT.max_wait_ms)]
     pub max_wait_ms: u32,
+    /// Longest hold at a motion beat (a pause of the hands) waiting for an onset (ms; 0: no
+    /// holds).
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.beat_hold_ms)]
+    pub beat_hold_ms: u32,
     /// Cost of entering a segment entered just now, falling to 0 over --recency-ms (0: no
     /// recency cost).
     #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_cost)]
@@ -183,6 +187,7 @@ impl DeviceArgs {
             ("--blend-ms", self.blend_ms, 5_000),
             ("--onset-window-ms", self.onset_window_ms, 1_000),
             ("--max-wait-ms", self.max_wait_ms, 5_000),
+            ("--beat-hold-ms", self.beat_hold_ms, 1_000),
         ] {
             if v > max {
                 return Err(format!("{name} must be at most {max}, not {v}").into());
@@ -200,6 +205,7 @@ impl DeviceArgs {
                 sync_to_onsets: true,
                 onset_window_ms: self.onset_window_ms,
                 max_wait_ms: self.max_wait_ms,
+                beat_hold_ms: self.beat_hold_ms,
             }
         };
         opts.variety = gesture_runtime::policy::Variety {

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 
 use super::args::{parse_span, ControlArgs, CorpusArgs, DeviceArgs};
 use super::CliError;
+use crate::evaluate::metrics::MotionMetrics;
 use crate::evaluate::motion::{evaluate_motion, Evaluation, MotionEval};
+use crate::evaluate::table::motion_table;
 use crate::inference::model::InferenceModel;
 use crate::pack::PackOptions;
 
@@ -75,10 +77,6 @@ pub fn evaluate(a: &EvalMotionArgs) -> Result<Evaluation, CliError> {
     Ok(evaluate_motion(&model, &settings)?)
 }
 
-fn opt(v: Option<f64>, prec: usize) -> String {
-    v.map_or_else(|| "-".into(), |x| format!("{x:.prec$}"))
-}
-
 /// Runs the command.
 pub fn run(a: &EvalMotionArgs) -> Result<(), CliError> {
     let ev = evaluate(a)?;
@@ -93,37 +91,13 @@ pub fn run(a: &EvalMotionArgs) -> Result<(), CliError> {
         ev.decisions,
         100.0 * ev.variety_regret
     )?;
-    outln!("variety                 distinct  of lib   max share  entropy  repeats<5s  cuts/s")?;
-    outln!("                        (segs)    (%)      (%)        (bits)   (%)         (1/s)")?;
-    for r in &ev.rows {
-        let m = &r.metrics;
-        outln!(
-            "{:<22} {:>8} {:>8} {:>10.1} {:>8.2} {:>11.1} {:>7.2}",
-            r.method,
-            m.distinct_segments,
-            opt(m.library_share.map(|v| 100.0 * v), 1),
-            100.0 * m.max_segment_share,
-            m.usage_entropy_bits,
-            100.0 * m.repeat_5s_share,
-            m.cuts_per_s
-        )?;
+    let rows: Vec<(&str, &MotionMetrics)> = ev
+        .rows
+        .iter()
+        .map(|r| (r.method.as_str(), &r.metrics))
+        .collect();
+    for line in motion_table(&rows) {
+        outln!("{line}")?;
     }
-    outln!("motion                  still  foot speed  jerk         jump at cuts  max jump  p99 step  beat   hand speed")?;
-    outln!("                        (%)    (cm/s)      (cm/s3)      (cm)          (cm)      (cm)      align  Hellinger")?;
-    for r in &ev.rows {
-        let m = &r.metrics;
-        outln!(
-            "{:<22} {:>5.1} {:>11} {:>12.0} {:>13.2} {:>9.2} {:>9.2} {:>6.3} {:>10}",
-            r.method,
-            100.0 * m.still_share,
-            opt(m.foot_speed, 2),
-            m.mean_jerk,
-            m.jump_at_cuts,
-            m.max_jump_at_cuts,
-            m.p99_step,
-            m.beat_alignment,
-            opt(m.hellinger, 3)
-        )?;
-    }
-    outln!("(lengths in skeleton units: cm on the shared data)")
+    Ok(())
 }

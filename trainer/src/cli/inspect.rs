@@ -65,6 +65,19 @@ pub fn summary(b: &Blob<'_>) -> String {
             "at every exit point at once".to_string()
         }
     );
+    let v = b.variety();
+    let _ = writeln!(
+        s,
+        "variety: recency cost {} over {} ms, usage cost {} over {} ms; cuts blended over {} ms; \
+         beat hold {} ms",
+        v.recency_cost,
+        v.recency_ms,
+        v.usage_cost,
+        v.usage_ms,
+        b.blend_ms(),
+        t.beat_hold_ms
+    );
+    let continued = (0..b.segments()).filter(|&i| b.continues(i)).count();
     let _ = writeln!(
         s,
         "inference: {} states, {} clusters, window {}",
@@ -90,14 +103,16 @@ pub fn summary(b: &Blob<'_>) -> String {
     let _ = writeln!(
         s,
         "library: {} segments, {} frames, {} channels, {} fps ({:.2} s of frames), {} with a \
-         stroke, {} labelled",
+         stroke, {} labelled, {} run on into their recorded successor, {} rotation groups",
         b.segments(),
         b.frames(),
         b.channels(),
         b.fps(),
         b.frames() as f64 / b.fps() as f64,
         segs.iter().filter(|x| x.stroke.is_some()).count(),
-        segs.iter().filter(|x| x.label.is_some()).count()
+        segs.iter().filter(|x| x.label.is_some()).count(),
+        continued,
+        b.group_count()
     );
     let names: Vec<&str> = b.channel_names().collect();
     let _ = writeln!(

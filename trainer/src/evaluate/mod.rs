@@ -1,8 +1,12 @@
 //! Evaluations that run what the device runs: the model and library packed into blob bytes,
 //! read back and driven through the runtime's device loop.
 //!
-//! - [`motion`]: motion quality of the online controller on held-out audio against random
-//!   selection, the offline DP reference and the motion capture.
+//! - [`metrics`]: the motion-quality figures of one motion (variety, freezes, feet,
+//!   smoothness, beats, hand speeds), from poses on the library's skeleton.
+//! - [`motion`]: motion quality of the online controller on held-out audio against its
+//!   ablations, random selection, the offline DP reference and the motion capture.
+//! - [`table`]: the printed table of those figures.
 
 pub mod metrics;
 pub mod motion;
+pub mod table;

@@ -32,13 +32,13 @@ use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::inference::StepNormalizer;
 use gesture_runtime::player::{LibraryFrames, Player, MAX_CHANNELS};
 use gesture_runtime::policy::{Choice, Variety};
-use gesture_runtime::prosody::{ProsodyConfig, StepKind};
+use gesture_runtime::prosody::ProsodyConfig;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::metrics::{entries_from_frames, measure, Entry, MotionMetrics, Trace};
+use super::metrics::{entries_from_frames, measure, Entry, MotionMetrics, Speech, Trace};
 use crate::control::mdp::Action;
 use crate::control::schedule::{play_dp, play_random, Played};
 use crate::inference::model::InferenceModel;
@@ -342,47 +342,36 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     let fps = lib.fps;
     let seconds = samples.len() as f64 / rate as f64;
     let frames = (seconds * fps) as usize;
-    let onsets: Vec<f64> = steps
-        .iter()
-        .filter(|s| s.kind == StepKind::Syllable)
-        .map(|s| s.start_s())
-        .collect();
+    let speech = Speech::from_steps(&steps);
     let reference = match &e.mocap {
         Some(p) => Some(mocap_trace(p, e, |mo_fps| (seconds * mo_fps) as usize)?),
         None => None,
     };
-    let ref_hands = reference.as_ref().map(|(t, _)| (t.hands.clone(), t.fps));
+    // Hand speeds are compared with the speech's own capture when there is one, else with the
+    // library's capture (the character's own range of motion).
+    let ref_hands = match &reference {
+        Some((t, _)) => (t.hands.clone(), t.fps),
+        None => {
+            let mut hands = Vec::new();
+            for take in &lib.takes {
+                let pos = &take.analysis.positions;
+                hands.extend((0..pos.frames()).map(|f| pos.frame(f).to_vec()));
+            }
+            (hands, fps)
+        }
+    };
+    let ref_hands = Some(ref_hands);
     let segments = lib.segments.len();
     let measured = |p: &Playback| -> Result<MotionMetrics, EvalError> {
         let t = trace_of(&blob, &skeleton, p, &pack)?;
         // Hand speeds are compared at the reference's own rate.
         let r = ref_hands.as_ref().map(|(h, f)| (h.as_slice(), *f));
-        Ok(measure(&t, &onsets, Some(segments), r))
+        Ok(measure(&t, &speech, Some(segments), r))
     };
     let mut rows = Vec::new();
 
     // The device, as packed.
     let (online, made) = play_online(&blob, &samples, frames, |_| {})?;
-    if std::env::var_os("GESTURE_DEBUG_JUMPS").is_some() {
-        let t = trace_of(&blob, &skeleton, &online, &pack)?;
-        for f in 1..t.frames() {
-            let d: f64 = t.hands[f - 1]
-                .iter()
-                .zip(&t.hands[f])
-                .map(|(a, b)| {
-                    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-                })
-                .sum::<f64>()
-                / 2.0;
-            if d > 4.0 {
-                eprintln!(
-                    "frame {f}: step {d:.2} shown {:?} -> {:?}",
-                    online.shown[f - 1],
-                    online.shown[f]
-                );
-            }
-        }
-    }
     rows.push(Row {
         method: "online".into(),
         metrics: measured(&online)?,
@@ -436,7 +425,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     if let Some((t, _)) = &reference {
         rows.push(Row {
             method: "mocap".into(),
-            metrics: measure(t, &onsets, None, Some((&t.hands, t.fps))),
+            metrics: measure(t, &speech, None, Some((&t.hands, t.fps))),
         });
     }
     // What variety costs against the pure policy.

@@ -14,6 +14,7 @@ use gesture_runtime::rig::ChannelCal;
 use super::{PackError, PackOptions};
 use crate::control::build::ControlModel;
 use crate::control::Library;
+use crate::evaluate::metrics::beat_frames;
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::inference_section;
 use crate::motion::Skeleton;
@@ -55,7 +56,15 @@ pub fn parts(
     // Channel angles of every frame, take after take.
     let mut frames: Vec<Vec<f32>> = Vec::new();
     let mut offsets = Vec::with_capacity(lib.takes.len());
+    let mut beats = Vec::new();
     for t in &lib.takes {
+        let pos = &t.analysis.positions;
+        let hands: Vec<Vec<[f64; 3]>> = (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect();
+        beats.extend(
+            beat_frames(&hands, t.motion.fps())
+                .into_iter()
+                .map(|b| frames.len() + b),
+        );
         let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
         offsets.push(frames.len());
         let values = bound.take_values(&t.motion).ok_or_else(|| {
@@ -118,6 +127,7 @@ pub fn parts(
                 rig.channels.len(),
                 &frames,
                 &segments,
+                &beats,
                 &rotation_groups(
                     rig,
                     &lib.takes[0].motion.skeleton().clone(),
