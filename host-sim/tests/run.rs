@@ -263,6 +263,76 @@ fn run_writes_every_output_full_skeleton() {
     check_outputs(&s.full, &out);
 }
 
+/// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
+/// counted here, every figure is finite, and broken folders are one line and exit 2.
+#[test]
+fn metrics_of_a_run_folder_agree_with_its_timeline() {
+    let s = setup();
+    let out = s.root.join("out-metrics");
+    let o = run_into(&s.full, &s.wav, &out, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = sim(&["metrics", out.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let tl: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("timeline.json")).unwrap()).unwrap();
+    let entries = tl["entries"].as_array().unwrap();
+    let ticks = std::fs::read_to_string(out.join("servo.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    // Frames per segment from the entries, counted here.
+    let mut frames: std::collections::BTreeMap<u64, usize> = Default::default();
+    for (k, e) in entries.iter().enumerate() {
+        let start = e["tick"].as_u64().unwrap() as usize;
+        let end = entries
+            .get(k + 1)
+            .map_or(ticks, |n| n["tick"].as_u64().unwrap() as usize);
+        *frames.entry(e["segment"].as_u64().unwrap()).or_default() += end - start;
+    }
+    let covered: usize = frames.values().sum();
+    let max_share = *frames.values().max().unwrap() as f64 / covered as f64;
+    assert_eq!(m["entries"].as_u64().unwrap() as usize, entries.len());
+    assert_eq!(
+        m["distinct_segments"].as_u64().unwrap() as usize,
+        frames.len()
+    );
+    assert!((m["max_segment_share"].as_f64().unwrap() - max_share).abs() < 1e-9);
+    let cuts = entries
+        .iter()
+        .filter(|e| e["cut"].as_bool().unwrap() && e["tick"].as_u64().unwrap() > 0)
+        .count();
+    let seconds = m["seconds"].as_f64().unwrap();
+    assert!((m["cuts_per_s"].as_f64().unwrap() - cuts as f64 / seconds).abs() < 1e-9);
+    for (k, v) in m.as_object().unwrap() {
+        if let Some(x) = v.as_f64() {
+            assert!(x.is_finite(), "{k} = {x}");
+        }
+    }
+    // The table names its units.
+    let o = sim(&["metrics", out.to_str().unwrap()]);
+    assert!(o.status.success());
+    assert!(text(&o.stdout).contains("(cm/s)"));
+    // A folder without a timeline, and a timeline of the first version.
+    let empty = s.root.join("metrics-empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = sim(&["metrics", empty.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(text(&o.stderr).lines().count(), 1, "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("timeline.json"));
+    let old = s.root.join("metrics-v1");
+    std::fs::create_dir_all(&old).unwrap();
+    std::fs::write(
+        old.join("timeline.json"),
+        r#"{"format":"gesture-sim-timeline","version":1,"segments":2,"steps":[],"entries":[]}"#,
+    )
+    .unwrap();
+    let o = sim(&["metrics", old.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("version 1"), "{}", text(&o.stderr));
+}
+
 #[test]
 fn run_writes_every_output_puppet_rig_with_rig_override() {
     let s = setup();
