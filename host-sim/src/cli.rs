@@ -83,6 +83,9 @@ pub enum Command {
         /// Audio chunk length in ms (how often the device would process samples).
         #[arg(long, default_value_t = 10.0, value_parser = parse_chunk_ms)]
         chunk_ms: f64,
+        /// Do not write preview.mp4 (the video with the speech, made with ffmpeg).
+        #[arg(long)]
+        no_video: bool,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
     /// utterance, and `run` on it (about a minute).
@@ -153,6 +156,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             rig,
             realtime,
             chunk_ms,
+            no_video,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -161,6 +165,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 rig: rig.clone(),
                 realtime: *realtime,
                 chunk_ms: *chunk_ms,
+                video: !*no_video,
             },
             out,
         ),

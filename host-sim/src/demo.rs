@@ -224,6 +224,8 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
             rig: None,
             realtime: false,
             chunk_ms: 10.0,
+            // The video of the character (with ffmpeg); the puppet's would show the same run.
+            video: name == "run-character",
         };
         line(
             out,

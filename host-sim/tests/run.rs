@@ -263,6 +263,71 @@ fn run_writes_every_output_full_skeleton() {
     check_outputs(&s.full, &out);
 }
 
+/// `preview.mp4`: the speech as its sound track, real-time length; `--no-video` and a PATH
+/// without ffmpeg write everything else (the latter says how to get it in one line).
+#[test]
+fn run_writes_a_video_with_the_speech_when_ffmpeg_is_there() {
+    let s = setup();
+    let have_ffmpeg = Command::new("ffmpeg").arg("-version").output().is_ok();
+    // No ffmpeg on PATH: the other outputs, and one line saying how to get it.
+    let out = s.root.join("out-no-ffmpeg");
+    let empty = s.root.join("empty-path");
+    std::fs::create_dir_all(&empty).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gesture-sim"))
+        .env("PATH", &empty)
+        .args(["run", "--blob", s.full.to_str().unwrap(), "--audio"])
+        .args([s.wav.to_str().unwrap(), "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(
+        stdout.contains("no preview.mp4") && stdout.contains("apt-get install ffmpeg"),
+        "{stdout}"
+    );
+    assert!(!out.join("preview.mp4").exists());
+    assert!(out.join("preview.gif").exists());
+    // --no-video: not even the note.
+    let out = s.root.join("out-no-video");
+    let o = run_into(&s.full, &s.wav, &out, &["--no-video"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!text(&o.stdout).contains("preview.mp4"));
+    assert!(!out.join("preview.mp4").exists());
+    if !have_ffmpeg {
+        eprintln!("skipping the video itself: no ffmpeg on PATH");
+        return;
+    }
+    let out = s.root.join("out-video");
+    let o = run_into(&s.full, &s.wav, &out, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let mp4 = std::fs::read(out.join("preview.mp4")).unwrap();
+    assert_eq!(&mp4[4..8], b"ftyp", "not an MP4");
+    // Its streams: H.264 video and AAC audio, each as long as the speech.
+    let probe = Command::new("ffprobe")
+        .args(["-v", "error", "-show_entries", "stream=codec_name,duration"])
+        .args(["-of", "csv=p=0"])
+        .arg(out.join("preview.mp4"))
+        .output();
+    let Ok(probe) = probe else {
+        eprintln!("no ffprobe: stream check skipped");
+        return;
+    };
+    let wav = hound::WavReader::open(&s.wav).unwrap();
+    let seconds = wav.duration() as f64 / wav.spec().sample_rate as f64;
+    let streams = text(&probe.stdout);
+    let mut codecs = Vec::new();
+    for line in streams.lines() {
+        let (codec, dur) = line.split_once(',').unwrap();
+        let dur: f64 = dur.parse().unwrap();
+        assert!(
+            (dur - seconds).abs() < 0.1,
+            "{codec}: {dur} s vs {seconds} s"
+        );
+        codecs.push(codec.to_string());
+    }
+    assert_eq!(codecs, ["h264", "aac"], "{streams}");
+}
+
 /// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
 /// counted here, every figure is finite, and broken folders are one line and exit 2.
 #[test]

@@ -27,6 +27,7 @@
 pub mod preview;
 pub mod sim;
 pub mod timeline;
+pub mod video;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -58,6 +59,8 @@ pub struct RunConfig {
     pub realtime: bool,
     /// Audio chunk length (ms).
     pub chunk_ms: f64,
+    /// Write `preview.mp4` (when `ffmpeg` is on `PATH`).
+    pub video: bool,
 }
 
 /// Why `run` failed.
@@ -215,6 +218,8 @@ pub struct Outputs {
     pub files: Vec<(&'static str, Vec<u8>)>,
     /// Frames in `motion.bvh` (0 if not written).
     pub bvh_frames: usize,
+    /// Lines for the summary about outputs that were not made (e.g. no `ffmpeg`).
+    pub notes: Vec<String>,
 }
 
 /// `servo.csv` of a run.
@@ -235,11 +240,12 @@ pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
     s
 }
 
-/// Renders every output of a run.
+/// Renders every output of a run; with `video_audio`, also `preview.mp4` with that sound track.
 pub fn render(
     sim: &Simulation,
     blob: &Blob<'_>,
     cx: timeline::Context<'_>,
+    video_audio: Option<&Path>,
 ) -> Result<Outputs, RunError> {
     let render_err = |what| move |reason: String| RunError::Render { what, reason };
     let skeleton = match blob.skeleton() {
@@ -273,7 +279,22 @@ pub fn render(
         "preview.gif",
         preview::animation(sim, skeleton.as_ref()).map_err(render_err("preview.gif"))?,
     ));
-    Ok(Outputs { files, bvh_frames })
+    let mut notes = Vec::new();
+    if let Some(audio) = video_audio {
+        if !video::ffmpeg_available() {
+            notes.push(video::NO_FFMPEG.to_string());
+        } else {
+            match video::render_mp4(sim, skeleton.as_ref(), audio) {
+                Ok(bytes) => files.push(("preview.mp4", bytes)),
+                Err(e) => notes.push(format!("no preview.mp4: {e}")),
+            }
+        }
+    }
+    Ok(Outputs {
+        files,
+        bvh_frames,
+        notes,
+    })
 }
 
 /// Writes `files` into `dir` (created if needed), all or nothing
@@ -333,6 +354,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
                 |s| blob.segment(s).map_or(1, |x| x.len as usize),
             ),
         },
+        cfg.video.then_some(cfg.audio.as_path()),
     )?;
     let written = write_all(&cfg.out, &outputs.files)?;
     summary(
@@ -391,6 +413,9 @@ fn summary(
             out,
             "no motion.bvh: the blob has no skeleton section (packed with --no-skeleton)"
         )?;
+    }
+    for note in &outputs.notes {
+        writeln!(out, "{note}")?;
     }
     writeln!(
         out,

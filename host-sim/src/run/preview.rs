@@ -9,8 +9,9 @@
 //! many states still shows); a time axis in seconds.
 //!
 //! **The animation** (320 x 240, 10 frames per second): the stick figure over the same
-//! intensity and belief plot with a red cursor. At most [`GIF_MAX_FRAMES`] frames: a longer
-//! run is shown as a time-lapse (the frame step grows, the rate stays 10 fps).
+//! intensity and belief plot with a red cursor, at true speed. At most [`GIF_MAX_FRAMES`]
+//! frames (10 minutes): a longer run is shown as a time-lapse (the frame step grows, the rate
+//! stays 10 fps). `preview.mp4` ([`super::video`]) is the same with sound.
 //!
 //! **Why drawn by hand.** Both pictures are lines, rectangles and a few digits on a fixed
 //! palette, so a canvas of palette indices with Bresenham lines is about a hundred lines,
@@ -29,23 +30,23 @@ use gesture_trainer::motion::Motion;
 use super::sim::Simulation;
 use gesture_trainer::rig::PoseSkeleton;
 
-/// Most frames in the GIF.
-pub const GIF_MAX_FRAMES: usize = 300;
+/// Most frames in the GIF (10 minutes at 10 fps; a longer run becomes a time-lapse).
+pub const GIF_MAX_FRAMES: usize = 6000;
 /// GIF size.
 pub const GIF_W: usize = 320;
 /// GIF size.
 pub const GIF_H: usize = 240;
 
-const BG: u8 = 0;
+pub(super) const BG: u8 = 0;
 const GRID: u8 = 1;
 const MID: u8 = 2;
-const INK: u8 = 3;
+pub(super) const INK: u8 = 3;
 const BLUE: u8 = 4;
 const SYL: u8 = 5;
-const RED: u8 = 6;
+pub(super) const RED: u8 = 6;
 const GREEN: u8 = 7;
 const BONE: u8 = 8;
-const PANEL: u8 = 9;
+pub(super) const PANEL: u8 = 9;
 const RAMP0: u8 = 16;
 const RAMP_N: usize = 64;
 const PALETTE_LEN: usize = 128;
@@ -53,7 +54,7 @@ const PALETTE_LEN: usize = 128;
 const KEEP: u8 = 127;
 
 /// The palette as RGB triples: fixed colours, then a 64-step dark-blue-to-yellow ramp.
-fn palette() -> Vec<u8> {
+pub(super) fn palette() -> Vec<u8> {
     let mut p = vec![0u8; PALETTE_LEN * 3];
     let fixed: [[u8; 3]; 10] = [
         [250, 250, 247],
@@ -102,10 +103,10 @@ fn ramp(v: f32) -> u8 {
 
 /// Palette-index pixels.
 #[derive(Clone)]
-struct Canvas {
-    w: usize,
-    h: usize,
-    px: Vec<u8>,
+pub(super) struct Canvas {
+    pub(super) w: usize,
+    pub(super) h: usize,
+    pub(super) px: Vec<u8>,
 }
 
 /// 3 x 5 digits, '.', 's' (rows top to bottom, 3 bits each, MSB left).
@@ -128,7 +129,7 @@ fn glyph(c: char) -> Option<[u8; 5]> {
 }
 
 impl Canvas {
-    fn new(w: usize, h: usize, c: u8) -> Self {
+    pub(super) fn new(w: usize, h: usize, c: u8) -> Self {
         Self {
             w,
             h,
@@ -142,7 +143,7 @@ impl Canvas {
         }
     }
 
-    fn fill(&mut self, x0: i64, y0: i64, x1: i64, y1: i64, c: u8) {
+    pub(super) fn fill(&mut self, x0: i64, y0: i64, x1: i64, y1: i64, c: u8) {
         for y in y0.max(0)..y1.min(self.h as i64) {
             for x in x0.max(0)..x1.min(self.w as i64) {
                 self.px[y as usize * self.w + x as usize] = c;
@@ -151,7 +152,7 @@ impl Canvas {
     }
 
     /// Bresenham's line, endpoints included.
-    fn line(&mut self, a: (i64, i64), b: (i64, i64), c: u8) {
+    pub(super) fn line(&mut self, a: (i64, i64), b: (i64, i64), c: u8) {
         let (mut x, mut y) = a;
         let (dx, dy) = ((b.0 - a.0).abs(), -(b.1 - a.1).abs());
         let (sx, sy) = (
@@ -177,7 +178,7 @@ impl Canvas {
         }
     }
 
-    fn thick_line(&mut self, a: (i64, i64), b: (i64, i64), c: u8) {
+    pub(super) fn thick_line(&mut self, a: (i64, i64), b: (i64, i64), c: u8) {
         for (ox, oy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
             self.line((a.0 + ox, a.1 + oy), (b.0 + ox, b.1 + oy), c);
         }
@@ -198,7 +199,7 @@ impl Canvas {
     }
 
     /// Digits at 2x scale, top-left at (x, y); returns the width drawn.
-    fn text(&mut self, x: i64, y: i64, s: &str, c: u8) -> i64 {
+    pub(super) fn text(&mut self, x: i64, y: i64, s: &str, c: u8) -> i64 {
         let mut cx = x;
         for ch in s.chars() {
             if let Some(g) = glyph(ch) {
@@ -218,7 +219,7 @@ impl Canvas {
 }
 
 /// Stick-figure geometry: 2-D points per frame and the bones between them.
-struct Figure {
+pub(super) struct Figure {
     /// Per frame, per point (joints then end sites): world (x, y).
     frames: Vec<Vec<(f64, f64)>>,
     bones: Vec<(usize, usize)>,
@@ -228,7 +229,14 @@ struct Figure {
 }
 
 impl Figure {
-    fn new(sk: &PoseSkeleton, poses: &[&Vec<f32>], fps: f64) -> Option<Self> {
+    /// The figure of `poses` seen from the front (world X right, Y up) or, with `side`, from
+    /// the character's left (world Z right, Y up).
+    pub(super) fn new(
+        sk: &PoseSkeleton,
+        poses: &[&Vec<f32>],
+        fps: f64,
+        side: bool,
+    ) -> Option<Self> {
         if poses.is_empty() {
             return None;
         }
@@ -261,7 +269,12 @@ impl Figure {
             })
             .and_then(|j| index(Target::EndSite(j)).or(index(Target::Joint(j))));
         let frames: Vec<Vec<(f64, f64)>> = (0..pos.frames())
-            .map(|f| pos.frame(f).iter().map(|p| (p[0], p[1])).collect())
+            .map(|f| {
+                pos.frame(f)
+                    .iter()
+                    .map(|p| (if side { p[2] } else { p[0] }, p[1]))
+                    .collect()
+            })
             .collect();
         let mut bbox = (
             f64::INFINITY,
@@ -291,7 +304,7 @@ impl Figure {
     }
 
     /// Draws frame `f` into the box (x, y, w, h).
-    fn draw(&self, cv: &mut Canvas, f: usize, (x, y, w, h): (i64, i64, i64, i64)) {
+    pub(super) fn draw(&self, cv: &mut Canvas, f: usize, (x, y, w, h): (i64, i64, i64, i64)) {
         let Some(pts) = self.frames.get(f) else {
             return;
         };
@@ -324,13 +337,13 @@ impl Figure {
 }
 
 /// The time plot of a run: intensity with syllables, decisions, belief heat strip.
-struct Plot<'a> {
+pub(super) struct Plot<'a> {
     sim: &'a Simulation,
     top_db: f32,
 }
 
 impl<'a> Plot<'a> {
-    fn new(sim: &'a Simulation) -> Self {
+    pub(super) fn new(sim: &'a Simulation) -> Self {
         let top_db = sim
             .frames
             .iter()
@@ -352,7 +365,12 @@ impl<'a> Plot<'a> {
     }
 
     /// Intensity panel in (x, y, w, h); `marks`: times of grey guide lines.
-    fn intensity(&self, cv: &mut Canvas, (x, y, w, h): (i64, i64, i64, i64), marks: &[f64]) {
+    pub(super) fn intensity(
+        &self,
+        cv: &mut Canvas,
+        (x, y, w, h): (i64, i64, i64, i64),
+        marks: &[f64],
+    ) {
         cv.fill(x, y, x + w, y + h, PANEL);
         let tx = |t: f64| x + ((t / self.dur()) * (w - 1) as f64).round() as i64;
         for s in &self.sim.steps {
@@ -397,7 +415,7 @@ impl<'a> Plot<'a> {
     }
 
     /// Belief heat strip in (x, y, w, h).
-    fn belief(&self, cv: &mut Canvas, (x, y, w, h): (i64, i64, i64, i64)) {
+    pub(super) fn belief(&self, cv: &mut Canvas, (x, y, w, h): (i64, i64, i64, i64)) {
         let steps = &self.sim.steps;
         let states = steps.first().map_or(1, |s| s.belief.len().max(1));
         let uniform = 1.0 / states as f32;
@@ -475,7 +493,7 @@ pub fn contact_sheet(sim: &Simulation, sk: Option<&PoseSkeleton>) -> Result<Vec<
         .collect();
     if let Some(fig) = sk.and_then(|sk| {
         let poses: Vec<&Vec<f32>> = ticks.iter().filter_map(|&i| sim.poses.get(i)).collect();
-        Figure::new(sk, &poses, sim.fps)
+        Figure::new(sk, &poses, sim.fps, false)
     }) {
         for (k, t) in times.iter().enumerate() {
             let x = margin + k as i64 * cell_w;
@@ -519,7 +537,7 @@ pub fn animation(sim: &Simulation, sk: Option<&PoseSkeleton>) -> Result<Vec<u8>,
         .collect();
     let fig = sk.and_then(|sk| {
         let poses: Vec<&Vec<f32>> = ticks.iter().filter_map(|&i| sim.poses.get(i)).collect();
-        Figure::new(sk, &poses, sim.fps)
+        Figure::new(sk, &poses, sim.fps, false)
     });
     let fig_h = 150i64;
     let (px, pw) = (6i64, w - 12);
