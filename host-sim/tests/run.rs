@@ -114,13 +114,48 @@ fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
-const OUTPUTS: [&str; 5] = [
+const OUTPUTS: [&str; 6] = [
     "motion.bvh",
     "timeline.json",
     "servo.csv",
     "preview.png",
     "preview.gif",
+    "viewer.html",
 ];
+
+/// `viewer.html` holds the speech (a WAV as long as the run) and a skeleton frame per 1/30 s
+/// whose bones index its points; one script, no network.
+fn check_viewer(dir: &Path, seconds: f64) {
+    use base64::Engine;
+    let html = std::fs::read_to_string(dir.join("viewer.html")).unwrap();
+    assert_eq!(html.matches("<script").count(), 1);
+    assert!(!html.contains("http://") && !html.contains("https://"));
+    let data = html.split("const DATA = ").nth(1).unwrap();
+    let data = &data[..data.find(";\nconst audio").unwrap()];
+    let v: serde_json::Value = serde_json::from_str(data).unwrap();
+    let frames = v["frames"].as_array().unwrap();
+    let points = v["points"].as_u64().unwrap() as usize;
+    assert!(points > 0);
+    assert!(
+        ((frames.len() as f64) - seconds * 30.0).abs() <= 1.0,
+        "{}",
+        frames.len()
+    );
+    assert!(frames
+        .iter()
+        .all(|f| f.as_array().unwrap().len() == 3 * points));
+    for b in v["bones"].as_array().unwrap() {
+        assert!(b[0].as_u64().unwrap() < points as u64 && b[1].as_u64().unwrap() < points as u64);
+    }
+    let b64 = html.split("data:audio/wav;base64,").nth(1).unwrap();
+    let b64 = &b64[..b64.find('"').unwrap()];
+    let wav = base64::engine::general_purpose::STANDARD
+        .decode(b64)
+        .unwrap();
+    let r = hound::WavReader::new(std::io::Cursor::new(wav)).unwrap();
+    let audio_s = r.duration() as f64 / r.spec().sample_rate as f64;
+    assert!((audio_s - seconds).abs() < 0.05, "{audio_s} vs {seconds}");
+}
 
 /// Checks a run's folder against its blob: BVH frames = poses, decisions name real segments,
 /// duties within each channel's limits and within its slew per tick.
@@ -141,6 +176,7 @@ fn check_outputs(blob_path: &Path, dir: &Path) {
     assert!(ticks > 100, "{ticks}");
     let motion = read_bvh(dir.join("motion.bvh")).unwrap();
     assert_eq!(motion.frames(), ticks);
+    check_viewer(dir, tl["duration_s"].as_f64().unwrap());
     assert!((motion.fps() - blob.fps() as f64).abs() < 1e-3);
     let sk = blob.skeleton().unwrap();
     assert_eq!(motion.skeleton().joints.len(), sk.joints());
@@ -241,7 +277,12 @@ fn check_outputs(blob_path: &Path, dir: &Path) {
     while dec.read_next_frame().unwrap().is_some() {
         frames += 1;
     }
-    assert!((100..=300).contains(&frames), "{frames} frames");
+    // True speed: a frame per 0.1 s of audio.
+    let seconds = tl["duration_s"].as_f64().unwrap();
+    assert!(
+        (frames as f64 - seconds * 10.0).abs() <= 1.0,
+        "{frames} frames for {seconds} s"
+    );
 }
 
 #[test]

@@ -28,6 +28,7 @@ pub mod preview;
 pub mod sim;
 pub mod timeline;
 pub mod video;
+pub mod viewer;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -240,11 +241,13 @@ pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
     s
 }
 
-/// Renders every output of a run; with `video_audio`, also `preview.mp4` with that sound track.
+/// Renders every output of a run (`samples`: the speech at the blob's rate, for
+/// `viewer.html`); with `video_audio`, also `preview.mp4` with that sound track.
 pub fn render(
     sim: &Simulation,
     blob: &Blob<'_>,
     cx: timeline::Context<'_>,
+    samples: &[i16],
     video_audio: Option<&Path>,
 ) -> Result<Outputs, RunError> {
     let render_err = |what| move |reason: String| RunError::Render { what, reason };
@@ -279,6 +282,14 @@ pub fn render(
         "preview.gif",
         preview::animation(sim, skeleton.as_ref()).map_err(render_err("preview.gif"))?,
     ));
+    let title = format!("gesture-sim run: {} through {}", cx.audio, cx.blob);
+    let page = viewer::page(
+        &viewer::data(sim, skeleton.as_ref(), &title),
+        samples,
+        blob.prosody_config().sample_rate_hz,
+    )
+    .map_err(render_err("viewer.html"))?;
+    files.push(("viewer.html", page.into_bytes()));
     let mut notes = Vec::new();
     if let Some(audio) = video_audio {
         if !video::ffmpeg_available() {
@@ -354,6 +365,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
                 |s| blob.segment(s).map_or(1, |x| x.len as usize),
             ),
         },
+        &pcm.samples,
         cfg.video.then_some(cfg.audio.as_path()),
     )?;
     let written = write_all(&cfg.out, &outputs.files)?;
