@@ -369,6 +369,44 @@ fn run_writes_a_video_with_the_speech_when_ffmpeg_is_there() {
     assert_eq!(codecs, ["h264", "aac"], "{streams}");
 }
 
+/// `viewer.html` in a real browser (headless Chromium, when installed): the script runs and the
+/// skeleton frame it shows follows the audio clock (opened at 2.5 s: frame 75 at 30 fps).
+#[test]
+fn viewer_shows_the_frame_of_the_audio_clock_in_chromium() {
+    let s = setup();
+    let Some(chromium) = ["chromium", "chromium-browser", "google-chrome"]
+        .into_iter()
+        .find(|c| Command::new(c).arg("--version").output().is_ok())
+    else {
+        eprintln!("skipping: no chromium on PATH");
+        return;
+    };
+    let out = s.root.join("out-viewer");
+    let o = run_into(&s.full, &s.wav, &out, &["--no-video"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let url = format!("file://{}#t=2.5", out.join("viewer.html").display());
+    let profile = tempfile::tempdir().unwrap();
+    let o = Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--virtual-time-budget=5000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.path().display()))
+        .args(["--dump-dom", &url])
+        .output()
+        .unwrap();
+    let dom = text(&o.stdout);
+    let state = dom
+        .split("<output id=\"state\"")
+        .nth(1)
+        .and_then(|x| x.split('>').nth(1))
+        .and_then(|x| x.split('<').next())
+        .unwrap_or_else(|| panic!("no state in the page: {}", text(&o.stderr)));
+    assert_eq!(state, "t=2.500 frame=75", "{state}");
+}
+
 /// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
 /// counted here, every figure is finite, and broken folders are one line and exit 2.
 #[test]
