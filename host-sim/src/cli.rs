@@ -86,6 +86,14 @@ pub enum Command {
         /// Do not write preview.mp4 (the video with the speech, made with ffmpeg).
         #[arg(long)]
         no_video: bool,
+        /// Stream the played poses over the VMC protocol (OSC/UDP) to an avatar app at
+        /// HOST:PORT (e.g. 127.0.0.1:39539); with --realtime at their times.
+        #[arg(long, value_name = "HOST:PORT")]
+        vmc: Option<String>,
+        /// Humanoid bone map for --vmc (TOML lines `LeftUpperArm = "joint"`), overriding the
+        /// built-in name aliases.
+        #[arg(long, value_name = "FILE", requires = "vmc")]
+        bone_map: Option<PathBuf>,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
     /// utterance, and `run` on it (about a minute).
@@ -120,6 +128,12 @@ pub enum Command {
         /// Stop after this many seconds of audio.
         #[arg(long, value_parser = parse_seconds)]
         seconds: Option<f64>,
+        /// Stream the played poses over the VMC protocol (OSC/UDP) to HOST:PORT.
+        #[arg(long, value_name = "HOST:PORT")]
+        vmc: Option<String>,
+        /// Humanoid bone map for --vmc (overrides the built-in aliases).
+        #[arg(long, value_name = "FILE", requires = "vmc")]
+        bone_map: Option<PathBuf>,
     },
 }
 
@@ -157,6 +171,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             realtime,
             chunk_ms,
             no_video,
+            vmc,
+            bone_map,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -166,6 +182,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 realtime: *realtime,
                 chunk_ms: *chunk_ms,
                 video: !*no_video,
+                vmc: vmc.clone(),
+                bone_map: bone_map.clone(),
             },
             out,
         ),
@@ -182,6 +200,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             blob,
             device,
             seconds,
+            vmc,
+            bone_map,
         } => {
             let bytes = run_cmd::read_blob(blob)?;
             let b =
@@ -189,12 +209,25 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                     path: blob.clone(),
                     source,
                 })?;
+            let mut sender = match vmc {
+                Some(addr) => Some(run_cmd::vmc_sender(&b, addr, bone_map.as_deref())?),
+                None => None,
+            };
             let mut source = live::CpalSource::open(device.as_deref())?;
             let opts = LiveOptions {
                 seconds: *seconds,
                 redraw: io::IsTerminal::is_terminal(&io::stdout()),
             };
-            live::live_loop(&b, &mut source, opts, out)?;
+            live::live_loop_with(
+                &b,
+                &mut source,
+                opts,
+                out,
+                &mut |t, pose| match &mut sender {
+                    Some(v) => v.send(t, pose).map_err(|e| e.to_string()),
+                    None => Ok(()),
+                },
+            )?;
             Ok(())
         }
     }

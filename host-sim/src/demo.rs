@@ -226,6 +226,8 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
             chunk_ms: 10.0,
             // The video of the character (with ffmpeg); the puppet's would show the same run.
             video: name == "run-character",
+            vmc: None,
+            bone_map: None,
         };
         line(
             out,

@@ -52,6 +52,9 @@ pub enum SimError {
     /// `metrics` could not read or measure a run folder.
     #[error("{0}")]
     Metrics(String),
+    /// `--vmc` could not start or send.
+    #[error(transparent)]
+    Vmc(#[from] crate::vmc::VmcError),
 }
 
 impl From<RunError> for SimError {
@@ -70,6 +73,8 @@ impl SimError {
             Self::Live(e) => e.exit_code(),
             Self::Demo(e) => e.exit_code(),
             Self::Metrics(_) => 2,
+            Self::Vmc(crate::vmc::VmcError::Send(_)) => 1,
+            Self::Vmc(_) => 2,
         }
     }
 }

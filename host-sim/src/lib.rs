@@ -36,3 +36,4 @@ pub mod metrics_cmd;
 pub mod prosody_cmd;
 pub mod run;
 pub mod servo;
+pub mod vmc;

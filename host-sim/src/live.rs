@@ -187,6 +187,22 @@ pub fn live_loop(
     opts: LiveOptions,
     out: &mut dyn Write,
 ) -> Result<LiveStats, LiveError> {
+    live_loop_with(blob, source, opts, out, &mut |_, _| Ok(()))
+}
+
+/// Receives each played pose: its time (s from the start) and channel values.
+pub type PoseSink<'a> = dyn FnMut(f64, &[f32]) -> Result<(), String> + 'a;
+
+/// [`live_loop`], handing every pose (its time in seconds from the start, channel values) to
+/// `on_pose` as it is played (e.g. a VMC sender); its error stops the loop.
+pub fn live_loop_with(
+    blob: &Blob<'_>,
+    source: &mut dyn AudioSource,
+    opts: LiveOptions,
+    out: &mut dyn Write,
+    on_pose: &mut PoseSink<'_>,
+) -> Result<LiveStats, LiveError> {
+    let mut pose_err: Option<String> = None;
     let config = blob.prosody_config();
     let rate = config.sample_rate_hz;
     let mut slot = Box::new(None);
@@ -277,8 +293,11 @@ pub fn live_loop(
                         writeln!(out, "{line}")
                     }
                 }
-                ControllerEvent::Pose { tick, .. } => {
+                ControllerEvent::Pose { tick, pose, .. } => {
                     stats.ticks = tick + 1;
+                    if pose_err.is_none() {
+                        pose_err = on_pose(tick as f64 / fps.max(1e-9), pose).err();
+                    }
                     Ok(())
                 }
                 ControllerEvent::Frame(_) | ControllerEvent::Onset(_) => Ok(()),
@@ -287,6 +306,9 @@ pub fn live_loop(
                 io_err = Some(e);
             }
         });
+        if let Some(e) = pose_err.take() {
+            return Err(LiveError::Backend(e));
+        }
         if let Some(e) = io_err.take() {
             return Err(e.into());
         }

@@ -407,6 +407,104 @@ fn viewer_shows_the_frame_of_the_audio_clock_in_chromium() {
     assert_eq!(state, "t=2.500 frame=75", "{state}");
 }
 
+/// `--vmc`: a loopback receiver decodes the bundles: the synthetic character's 13 humanoid
+/// bones, unit quaternions, times a tick apart; a bad address is one line and exit 2.
+#[test]
+fn run_streams_vmc_bundles_a_receiver_decodes() {
+    let s = setup();
+    let rx = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    rx.set_read_timeout(Some(std::time::Duration::from_millis(500)))
+        .unwrap();
+    let addr = rx.local_addr().unwrap().to_string();
+    let receiver = std::thread::spawn(move || {
+        let mut got = Vec::new();
+        let mut buf = vec![0u8; 65536];
+        while let Ok(n) = rx.recv(&mut buf) {
+            got.push(buf[..n].to_vec());
+        }
+        got
+    });
+    let out = s.root.join("out-vmc");
+    let o = run_into(&s.full, &s.wav, &out, &["--no-video", "--vmc", &addr]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(stdout.contains("vmc: sent"), "{stdout}");
+    let got = receiver.join().unwrap();
+    let tl: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("timeline.json")).unwrap()).unwrap();
+    let ticks = tl["ticks"].as_u64().unwrap() as usize;
+    let fps = tl["fps"].as_f64().unwrap();
+    // UDP may drop a few on a busy machine; nearly all must arrive.
+    assert!(got.len() * 10 >= ticks * 9, "{} of {ticks}", got.len());
+    let mut last_t = -1.0;
+    for bytes in &got {
+        let (_, packet) = rosc::decoder::decode_udp(bytes).unwrap();
+        let rosc::OscPacket::Bundle(b) = packet else {
+            panic!("not a bundle")
+        };
+        let msgs: Vec<&rosc::OscMessage> = b
+            .content
+            .iter()
+            .map(|p| match p {
+                rosc::OscPacket::Message(m) => m,
+                _ => panic!("nested bundle"),
+            })
+            .collect();
+        assert_eq!(msgs[0].addr, "/VMC/Ext/Root/Pos");
+        let bones: Vec<&rosc::OscMessage> = msgs
+            .iter()
+            .copied()
+            .filter(|m| m.addr == "/VMC/Ext/Bone/Pos")
+            .collect();
+        let names: Vec<String> = bones
+            .iter()
+            .map(|m| m.args[0].clone().string().unwrap())
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "Hips",
+                "Spine",
+                "Chest",
+                "Neck",
+                "Head",
+                "LeftShoulder",
+                "LeftUpperArm",
+                "LeftLowerArm",
+                "LeftHand",
+                "RightShoulder",
+                "RightUpperArm",
+                "RightLowerArm",
+                "RightHand"
+            ]
+        );
+        for m in &bones {
+            let q: Vec<f32> = m.args[4..8]
+                .iter()
+                .map(|a| a.clone().float().unwrap())
+                .collect();
+            let norm = q.iter().map(|v| v * v).sum::<f32>().sqrt();
+            assert!((norm - 1.0).abs() < 1e-4, "{q:?}");
+        }
+        assert_eq!(msgs[msgs.len() - 2].addr, "/VMC/Ext/OK");
+        let t_msg = msgs[msgs.len() - 1];
+        assert_eq!(t_msg.addr, "/VMC/Ext/T");
+        let t = t_msg.args[0].clone().float().unwrap() as f64;
+        assert!(t > last_t, "{t} after {last_t}");
+        // Times are tick times.
+        let k = (t * fps).round();
+        assert!((t * fps - k).abs() < 1e-3, "{t}");
+        last_t = t;
+    }
+    // A bad address: one line, exit 2, nothing written.
+    let out = s.root.join("out-vmc-bad");
+    let o = run_into(&s.full, &s.wav, &out, &["--vmc", "no-such-host.invalid:1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
+    assert_eq!(text(&o.stderr).lines().count(), 1);
+    assert!(text(&o.stderr).contains("--vmc"));
+    assert!(!out.exists());
+}
+
 /// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
 /// counted here, every figure is finite, and broken folders are one line and exit 2.
 #[test]
@@ -698,6 +796,43 @@ use host_sim::live::{live_loop, AudioSource, FakeSource, LiveError, LiveOptions}
 fn mic_samples(s: &Setup) -> Vec<f32> {
     let pcm = gesture_trainer::audio::load_wav_at(&s.wav, 44_100).unwrap();
     pcm.samples.iter().map(|&v| v as f32 / 32768.0).collect()
+}
+
+/// `live --vmc` hands every played pose to the sender at its tick time; a sender that fails
+/// stops the loop with its error.
+#[test]
+fn live_loop_hands_every_pose_on_at_its_time() {
+    let s = setup();
+    let bytes = std::fs::read(&s.full).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let mut src = FakeSource::new(mic_samples(s), 44_100, 441 * 4);
+    let mut times = Vec::new();
+    let stats = host_sim::live::live_loop_with(
+        &blob,
+        &mut src,
+        LiveOptions::default(),
+        &mut Vec::new(),
+        &mut |t, pose| {
+            assert_eq!(pose.len(), blob.channels());
+            times.push(t);
+            Ok(())
+        },
+    )
+    .unwrap();
+    assert_eq!(times.len() as u64, stats.ticks);
+    for (k, t) in times.iter().enumerate() {
+        assert!((t - k as f64 / blob.fps() as f64).abs() < 1e-9);
+    }
+    let mut src = FakeSource::new(mic_samples(s), 44_100, 441 * 4);
+    let err = host_sim::live::live_loop_with(
+        &blob,
+        &mut src,
+        LiveOptions::default(),
+        &mut Vec::new(),
+        &mut |_, _| Err("receiver gone".into()),
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("receiver gone"), "{err}");
 }
 
 #[test]

@@ -62,6 +62,10 @@ pub struct RunConfig {
     pub chunk_ms: f64,
     /// Write `preview.mp4` (when `ffmpeg` is on `PATH`).
     pub video: bool,
+    /// Stream the poses over VMC to this `HOST:PORT` ([`crate::vmc`]).
+    pub vmc: Option<String>,
+    /// Bone-map file for `vmc`.
+    pub bone_map: Option<PathBuf>,
 }
 
 /// Why `run` failed.
@@ -335,6 +339,10 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     let (cals, period_us) = calibrations(&blob, &cfg.blob, cfg.rig.as_deref())?;
     let rate = blob.prosody_config().sample_rate_hz;
     let pcm = load_wav_at(&cfg.audio, rate).map_err(RunError::from)?;
+    let mut vmc = match &cfg.vmc {
+        Some(addr) => Some(vmc_sender(&blob, addr, cfg.bone_map.as_deref())?),
+        None => None,
+    };
     let chunk = ((cfg.chunk_ms / 1000.0 * rate as f64).round() as usize).max(1);
     let sim = simulate(
         &blob,
@@ -343,7 +351,8 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         period_us,
         SimOptions {
             chunk,
-            realtime: cfg.realtime,
+            // With --vmc the poses are paced as they are sent instead.
+            realtime: cfg.realtime && vmc.is_none(),
         },
     )
     .map_err(RunError::Sim)?;
@@ -368,7 +377,19 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         &pcm.samples,
         cfg.video.then_some(cfg.audio.as_path()),
     )?;
+    if let Some(v) = &mut vmc {
+        stream_vmc(v, &sim, cfg.realtime)?;
+    }
     let written = write_all(&cfg.out, &outputs.files)?;
+    if let (Some(v), Some(addr)) = (&vmc, &cfg.vmc) {
+        writeln!(
+            out,
+            "vmc: sent {} bundles of {} bones ({}) to {addr}",
+            v.sent,
+            v.stream.bones().count(),
+            v.stream.bones().collect::<Vec<_>>().join(" ")
+        )?;
+    }
     summary(
         out,
         cfg,
@@ -378,6 +399,38 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         &written,
         total.elapsed().as_secs_f64(),
     )?;
+    Ok(())
+}
+
+/// A VMC sender for the blob's skeleton.
+pub fn vmc_sender(
+    blob: &Blob<'_>,
+    addr: &str,
+    bone_map: Option<&Path>,
+) -> Result<crate::vmc::VmcSender, crate::vmc::VmcError> {
+    use crate::vmc::{BoneMap, VmcError, VmcSender, VmcStream};
+    let view = blob.skeleton().ok_or(VmcError::NoSkeleton)?;
+    let sk = PoseSkeleton::from_blob(&view).map_err(|_| VmcError::NoSkeleton)?;
+    let map = BoneMap::new(&sk, bone_map)?;
+    VmcSender::new(addr, VmcStream::new(sk, map))
+}
+
+/// Sends every pose of `sim`, at its time when `realtime`, else as fast as possible.
+fn stream_vmc(
+    v: &mut crate::vmc::VmcSender,
+    sim: &Simulation,
+    realtime: bool,
+) -> Result<(), crate::vmc::VmcError> {
+    let start = Instant::now();
+    for (k, pose) in sim.poses.iter().enumerate() {
+        let t = k as f64 / sim.fps.max(1e-9);
+        if realtime {
+            if let Some(wait) = std::time::Duration::from_secs_f64(t).checked_sub(start.elapsed()) {
+                std::thread::sleep(wait);
+            }
+        }
+        v.send(t, pose)?;
+    }
     Ok(())
 }
 
