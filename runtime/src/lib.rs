@@ -37,6 +37,7 @@
 //!   duty cycles through `embedded_hal::pwm::SetDutyCycle`; neutral pose on fault.
 //! - [`rotation`]: rotation matrices, quaternions and Euler angles in `f32` or `f64`, shared by
 //!   the device and the host tools.
+//! - `pca9685` (feature `pca9685`): the rig's servos on a PCA9685 16-channel I2C board.
 #![no_std]
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -51,5 +52,7 @@ pub mod inference;
 pub mod player;
 pub mod policy;
 pub mod prosody;
+#[cfg(feature = "pca9685")]
+pub mod pca9685;
 pub mod rig;
 pub mod rotation;

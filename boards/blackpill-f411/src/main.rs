@@ -19,100 +19,28 @@
 #![no_std]
 #![no_main]
 
-use core::cell::RefCell;
+mod mic;
+
 use core::convert::Infallible;
 
-use cortex_m::interrupt::Mutex;
 use cortex_m_rt::entry;
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::BlobController;
 use gesture_runtime::device::Device;
 use panic_halt as _;
-use stm32f4xx_hal::adc::config::{AdcConfig, Clock, SampleTime};
-use stm32f4xx_hal::adc::Adc;
-use stm32f4xx_hal::gpio::{Analog, Output, PushPull, PA0, PC13};
-use stm32f4xx_hal::pac::{self, interrupt, Interrupt, ADC1, TIM2, TIM3, TIM4};
+use stm32f4xx_hal::gpio::{Output, PushPull, PC13};
+use stm32f4xx_hal::pac::{self, TIM3, TIM4};
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::rcc::Config;
-use stm32f4xx_hal::timer::{CounterHz, ErasedChannel, Event};
+use stm32f4xx_hal::timer::ErasedChannel;
 
 /// The policy blob (`build.rs`).
 static BLOB: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/policy.blob"));
 
-/// Microphone sample rate (the blob's front-end must run at it).
-const RATE_HZ: u32 = 16_000;
-/// Samples per buffer (16 ms).
-const CHUNK: usize = 256;
+use mic::RATE_HZ;
 /// Servo channels (the blob's rig must have exactly these, e.g. `rigs/puppet-8ch.toml`).
 const CHANNELS: usize = 8;
-
-/// What the sampling interrupt owns.
-struct Mic {
-    adc: Adc<ADC1>,
-    pin: PA0<Analog>,
-    timer: CounterHz<TIM2>,
-}
-
-/// The double buffer between the sampling interrupt and the main loop.
-struct Buffers {
-    data: [[i16; CHUNK]; 2],
-    /// The half being filled.
-    filling: usize,
-    pos: usize,
-    /// A full half waiting for the main loop.
-    ready: Option<usize>,
-    overruns: u32,
-}
-
-impl Buffers {
-    const fn new() -> Self {
-        Self {
-            data: [[0; CHUNK]; 2],
-            filling: 0,
-            pos: 0,
-            ready: None,
-            overruns: 0,
-        }
-    }
-
-    fn push(&mut self, s: i16) {
-        self.data[self.filling][self.pos] = s;
-        self.pos += 1;
-        if self.pos == CHUNK {
-            if self.ready.is_some() {
-                // The main loop is late: the older buffer is dropped.
-                self.overruns = self.overruns.wrapping_add(1);
-            }
-            self.ready = Some(self.filling);
-            self.filling ^= 1;
-            self.pos = 0;
-        }
-    }
-
-    fn take(&mut self) -> Option<[i16; CHUNK]> {
-        self.ready.take().map(|half| self.data[half])
-    }
-}
-
-static MIC: Mutex<RefCell<Option<Mic>>> = Mutex::new(RefCell::new(None));
-static BUFFERS: Mutex<RefCell<Buffers>> = Mutex::new(RefCell::new(Buffers::new()));
-
-#[interrupt]
-fn TIM2() {
-    static mut LOCAL: Option<Mic> = None;
-    if LOCAL.is_none() {
-        *LOCAL = cortex_m::interrupt::free(|cs| MIC.borrow(cs).replace(None));
-    }
-    let Some(mic) = LOCAL.as_mut() else {
-        return;
-    };
-    let _ = mic.timer.wait();
-    // 12 bits around the module's half-supply bias, to full-scale i16.
-    let raw = mic.adc.convert(&mic.pin, SampleTime::Cycles_28) as i32;
-    let s = ((raw - 2048) << 4).clamp(i16::MIN as i32, i16::MAX as i32) as i16;
-    cortex_m::interrupt::free(|cs| BUFFERS.borrow(cs).borrow_mut().push(s));
-}
 
 /// One servo output: a channel of TIM3 or TIM4 (`ServoRig` wants one pin type).
 enum Servo {
@@ -208,27 +136,13 @@ fn main() -> ! {
     };
 
     // Microphone: TIM2 at 16 kHz, one ADC conversion per update interrupt.
-    // ADC clock 96 MHz / 4 = 24 MHz (at most 36 MHz): a conversion takes (28 + 12) / 24 MHz
-    // = 1.7 us of the 62.5 us between samples.
-    let adc_config = AdcConfig::default().clock(Clock::Pclk2_div_4);
-    let adc = Adc::new(dp.ADC1, true, adc_config, &mut rcc);
-    let pin = gpioa.pa0.into_analog();
-    let mut timer = dp.TIM2.counter_hz(&mut rcc);
-    if timer.start(RATE_HZ.Hz()).is_err() {
+    if mic::start(dp.ADC1, gpioa.pa0, dp.TIM2, &mut rcc).is_err() {
         refuse(&mut led);
     }
-    timer.listen(Event::Update);
-    cortex_m::interrupt::free(|cs| MIC.borrow(cs).replace(Some(Mic { adc, pin, timer })));
-    // SAFETY: the handler only touches what was moved into MIC and BUFFERS (both behind
-    // critical sections); unmasking cannot break a critical section in progress.
-    unsafe { cortex_m::peripheral::NVIC::unmask(Interrupt::TIM2) };
 
     let mut seen_overruns = 0;
     loop {
-        let (chunk, overruns) = cortex_m::interrupt::free(|cs| {
-            let mut b = BUFFERS.borrow(cs).borrow_mut();
-            (b.take(), b.overruns)
-        });
+        let (chunk, overruns) = mic::take();
         if overruns != seen_overruns {
             seen_overruns = overruns;
             led.toggle();
