@@ -49,10 +49,10 @@ pub mod blob;
 pub mod controller;
 pub mod device;
 pub mod inference;
+#[cfg(feature = "pca9685")]
+pub mod pca9685;
 pub mod player;
 pub mod policy;
 pub mod prosody;
-#[cfg(feature = "pca9685")]
-pub mod pca9685;
 pub mod rig;
 pub mod rotation;

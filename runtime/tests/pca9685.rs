@@ -49,12 +49,8 @@ fn known_poses_give_the_known_register_writes() {
     let mut bus = Mock::new(&expect);
     let mut board = Pca9685Servos::new(bus.clone(), ADDR, 20_000.0).unwrap();
     assert!((board.actual_period_us() - 19_988.48).abs() < 0.01);
-    let mut rig = ServoRig::new(
-        [Pca9685Pin::default(); 2],
-        [ChannelCal::HOBBY; 2],
-        20_000.0,
-    )
-    .unwrap();
+    let mut rig =
+        ServoRig::new([Pca9685Pin::default(); 2], [ChannelCal::HOBBY; 2], 20_000.0).unwrap();
     // A long tick: no slew limit in the way.
     rig.apply(&[0.0, 45.0], 10.0).unwrap();
     board.write(rig.pins()).unwrap();
