@@ -94,9 +94,13 @@ pub enum Command {
         /// built-in name aliases.
         #[arg(long, value_name = "FILE", requires = "vmc")]
         bone_map: Option<PathBuf>,
+        /// Also write blender.py and speech.wav: `blender --python DIR/blender.py` opens the
+        /// motion and its speech as one scene.
+        #[arg(long)]
+        blender: bool,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
-    /// utterance, and `run` on it (about a minute).
+    /// utterance, and `run` on it (a few seconds after the build).
     Demo {
         /// Output folder.
         #[arg(long, value_name = "DIR", default_value = "gesture-demo")]
@@ -173,6 +177,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             no_video,
             vmc,
             bone_map,
+            blender,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -184,6 +189,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 video: !*no_video,
                 vmc: vmc.clone(),
                 bone_map: bone_map.clone(),
+                blender: *blender,
             },
             out,
         ),

@@ -228,6 +228,7 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
             video: name == "run-character",
             vmc: None,
             bone_map: None,
+            blender: false,
         };
         line(
             out,

@@ -505,6 +505,36 @@ fn run_streams_vmc_bundles_a_receiver_decodes() {
     assert!(!out.exists());
 }
 
+/// `--blender`: a script next to motion.bvh and the speech it was played to (valid Python,
+/// naming both files), the speech as long as the run.
+#[test]
+fn blender_script_and_speech_sit_next_to_the_motion() {
+    let s = setup();
+    let out = s.root.join("out-blender");
+    let o = run_into(&s.full, &s.wav, &out, &["--no-video", "--blender"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let script = std::fs::read_to_string(out.join("blender.py")).unwrap();
+    assert!(script.contains("\"motion.bvh\"") && script.contains("\"speech.wav\""));
+    let tl: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("timeline.json")).unwrap()).unwrap();
+    let r = hound::WavReader::open(out.join("speech.wav")).unwrap();
+    let seconds = r.duration() as f64 / r.spec().sample_rate as f64;
+    assert!((seconds - tl["duration_s"].as_f64().unwrap()).abs() < 0.01);
+    match Command::new("python3")
+        .args(["-m", "py_compile"])
+        .arg(out.join("blender.py"))
+        .output()
+    {
+        Ok(o) => assert!(o.status.success(), "{}", text(&o.stderr)),
+        Err(_) => eprintln!("no python3: syntax check skipped"),
+    }
+    // Without --blender, neither file.
+    let out = s.root.join("out-no-blender");
+    let o = run_into(&s.full, &s.wav, &out, &["--no-video"]);
+    assert!(o.status.success());
+    assert!(!out.join("blender.py").exists() && !out.join("speech.wav").exists());
+}
+
 /// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
 /// counted here, every figure is finite, and broken folders are one line and exit 2.
 #[test]

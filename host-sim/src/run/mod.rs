@@ -24,6 +24,7 @@
 //! maximum syllable detection latency and the simulation speed as a multiple of real time
 //! (simulation only, without rendering and writing).
 
+pub mod blender;
 pub mod preview;
 pub mod sim;
 pub mod timeline;
@@ -66,6 +67,8 @@ pub struct RunConfig {
     pub vmc: Option<String>,
     /// Bone-map file for `vmc`.
     pub bone_map: Option<PathBuf>,
+    /// Also write `blender.py` and `speech.wav` ([`blender`]).
+    pub blender: bool,
 }
 
 /// Why `run` failed.
@@ -358,7 +361,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     .map_err(RunError::Sim)?;
     let audio_name = cfg.audio.display().to_string();
     let blob_name = cfg.blob.display().to_string();
-    let outputs = render(
+    let mut outputs = render(
         &sim,
         &blob,
         timeline::Context {
@@ -377,6 +380,22 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         &pcm.samples,
         cfg.video.then_some(cfg.audio.as_path()),
     )?;
+    if cfg.blender {
+        if blob.skeleton().is_none() {
+            outputs
+                .notes
+                .push("no blender.py: the blob has no skeleton, so there is no motion.bvh".into());
+        } else {
+            let wav = viewer::wav_bytes(&pcm.samples, rate).map_err(|reason| RunError::Render {
+                what: "speech.wav",
+                reason,
+            })?;
+            outputs.files.push(("speech.wav", wav));
+            outputs
+                .files
+                .push(("blender.py", blender::SCRIPT.as_bytes().to_vec()));
+        }
+    }
     if let Some(v) = &mut vmc {
         stream_vmc(v, &sim, cfg.realtime)?;
     }
@@ -467,7 +486,7 @@ fn summary(
     )?;
     for p in written {
         let extra = match p.file_name().and_then(|n| n.to_str()) {
-            Some("motion.bvh") => format!(" ({} frames at {} fps)", outputs.bvh_frames, sim.fps),
+            Some("motion.bvh") => format!(" ({} frames at {:.2} fps)", outputs.bvh_frames, sim.fps),
             Some("servo.csv") => format!(" ({} ticks)", sim.duties.len()),
             _ => String::new(),
         };

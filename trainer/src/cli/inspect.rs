@@ -107,7 +107,7 @@ pub fn summary(b: &Blob<'_>) -> String {
         b.segments(),
         b.frames(),
         b.channels(),
-        b.fps(),
+        short(b.fps()),
         b.frames() as f64 / b.fps() as f64,
         segs.iter().filter(|x| x.stroke.is_some()).count(),
         segs.iter().filter(|x| x.label.is_some()).count(),
@@ -115,14 +115,22 @@ pub fn summary(b: &Blob<'_>) -> String {
         b.group_count()
     );
     let names: Vec<&str> = b.channel_names().collect();
-    let _ = writeln!(
-        s,
-        "rig: {:?}, PWM period {} us, {} channels: {}",
+    // Wrapped at about 96 columns: a full-skeleton rig has hundreds of channels.
+    let mut line = format!(
+        "rig: {:?}, PWM period {} us, {} channels:",
         b.rig_name(),
         b.period_us(),
-        b.channels(),
-        names.join(", ")
+        b.channels()
     );
+    for (k, n) in names.iter().enumerate() {
+        let item = format!(" {n}{}", if k + 1 < names.len() { "," } else { "" });
+        if line.len() + item.len() > 96 && line.len() > 2 {
+            let _ = writeln!(s, "{line}");
+            line = " ".to_string();
+        }
+        line.push_str(&item);
+    }
+    let _ = writeln!(s, "{line}");
     match b.skeleton() {
         Some(sk) => {
             let root = sk.joint_name(0).unwrap_or("");
@@ -139,4 +147,12 @@ pub fn summary(b: &Blob<'_>) -> String {
         }
     }
     s
+}
+
+/// `v` with at most two decimals and no trailing zeros (a BVH's 0.0166667 s frame time is
+/// "60", not "59.99988").
+fn short(v: f32) -> String {
+    let t = format!("{v:.2}");
+    let t = t.trim_end_matches('0').trim_end_matches('.');
+    t.to_string()
 }
