@@ -371,6 +371,8 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     let mut rows = Vec::new();
 
     // The device, as packed.
+    // Drawn only when stderr is a terminal.
+    let progress = crate::progress::spinner("eval-motion: the device and its ablations");
     let (online, made) = play_online(&blob, &samples, frames, |_| {})?;
     rows.push(Row {
         method: "online".into(),
@@ -395,6 +397,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     });
     // References, played by the same player.
     let start = 0;
+    progress.set_message("eval-motion: random selection and the offline DP");
     let random: Vec<MotionMetrics> = (0..e.random_runs.max(1))
         .map(|seed| {
             measured(&play_schedule(
@@ -443,6 +446,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
             best_total += cb.abs();
         }
     }
+    progress.finish_and_clear();
     Ok(Evaluation {
         rows,
         library_segments: segments,

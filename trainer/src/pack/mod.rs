@@ -262,6 +262,8 @@ pub fn pack_model(
     opts: &PackOptions,
 ) -> Result<Packed, PackError> {
     let start = Instant::now();
+    // Drawn only when stderr is a terminal; a big library takes a while to load and solve.
+    let progress = crate::progress::spinner("pack: loading the library");
     let files: Vec<PathBuf> = discover(library)?
         .into_iter()
         .filter_map(|t| t.bvh)
@@ -298,6 +300,7 @@ pub fn pack_model(
     let (parts, frames) = parts(model, &lib, &rig, opts)?;
     let load_s = start.elapsed().as_secs_f64();
 
+    progress.set_message("pack: value iteration and pruning");
     let mut cm = build(model, &lib, &opts.control);
     let t_prune = Instant::now();
     let mut k = None;
@@ -327,9 +330,11 @@ pub fn pack_model(
     let sizes = blob.section_sizes();
     let write_s = t_write.elapsed().as_secs_f64();
     let t_regret = Instant::now();
+    progress.set_message("pack: regret of the packed tables");
     let decisions = 20_000;
     let r = regret(&lib, &cm, &blob, model, decisions, 7);
     let regret_s = t_regret.elapsed().as_secs_f64();
+    progress.finish_and_clear();
     let report = PackReport {
         blob_bytes: bytes.len(),
         section_bytes: SectionBytes {
