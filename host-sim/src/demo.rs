@@ -249,9 +249,10 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
     line(
         out,
         format!(
-            "done in {:.1} s. Open {d}/run-character/preview.png (contact sheet), preview.gif \
-             (animation) and motion.bvh (Blender: File > Import > BVH); {d}/run-puppet/servo.csv \
-             is what the 8 servos of the puppet would be sent.",
+            "done in {:.1} s. Open {d}/run-character/viewer.html in a browser (the character \
+             with its speech), preview.mp4 (the same as a video, when ffmpeg is installed), \
+             preview.png (contact sheet) or motion.bvh (Blender: File > Import > BVH); \
+             {d}/run-puppet/servo.csv is what the 8 servos of the puppet would be sent.",
             start.elapsed().as_secs_f64(),
         ),
     )?;
