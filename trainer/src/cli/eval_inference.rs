@@ -103,7 +103,7 @@ fn ari(
     for (s, ys) in seqs.iter().zip(y) {
         let r = runs.get(&s.stem)?;
         let post = base.hmm.posterior(ys);
-        for (g, &(a, b)) in post.gamma.iter().zip(&s.times) {
+        for (g, &(a, b)) in post.gamma_rows().zip(&s.times) {
             let mid = 0.5 * (a + b);
             let Some(&(_, _, state)) = r.iter().find(|(s0, s1, _)| mid >= *s0 && mid < *s1) else {
                 continue;

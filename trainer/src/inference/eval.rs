@@ -99,12 +99,13 @@ impl RemappedHmm {
             / dims as f64;
         let eps = (1e-3 * var).max(1e-6);
         let mean0 = vec![0.0; dims];
+        let k = base.hmm.states();
         let emit = (0..base.hmm.states())
             .map(|i| {
                 let w: Vec<f64> = base
                     .train
                     .iter()
-                    .flat_map(|q| q.gamma.iter().map(move |g| g[i]))
+                    .flat_map(|q| q.gamma.chunks_exact(k).map(move |g| g[i]))
                     .collect();
                 Gaussian::fit_weighted(&xs, &w, eps, &mean0)
             })

@@ -273,6 +273,7 @@ impl InferenceModel {
             hmm: Hmm {
                 init: f.hmm.init,
                 trans: f.hmm.trans,
+                cov_prior: super::gaussian::CovPrior::floor(6, f.hmm.eps),
                 emit,
                 eps: f.hmm.eps,
             },

@@ -293,14 +293,7 @@ pub fn fit_base(
     let train: Vec<TrainSeq> = seqs
         .iter()
         .zip(&y)
-        .map(|(s, ys)| {
-            let post = hmm.posterior(ys);
-            TrainSeq {
-                memberships: memberships(&gmm, s),
-                gamma: post.gamma,
-                xi: post.xi,
-            }
-        })
+        .map(|(s, ys)| TrainSeq::new(memberships(&gmm, s), hmm.posterior(ys)))
         .collect();
     let state_prior = hmm.state_frequencies(&y);
     Ok(FitBase {
@@ -316,21 +309,6 @@ pub fn fit_base(
 /// Candidate L2 strengths (per step) tried by [`choose_l2`].
 pub const L2_GRID: [f64; 4] = [1e-3, 1e-2, 0.1, 0.3];
 
-fn split_seq(q: &TrainSeq, cut: usize) -> (TrainSeq, TrainSeq) {
-    let cut = cut.clamp(1, q.memberships.len().saturating_sub(1).max(1));
-    let a = TrainSeq {
-        memberships: q.memberships[..cut].to_vec(),
-        gamma: q.gamma[..cut].to_vec(),
-        xi: q.xi[..cut.saturating_sub(1).min(q.xi.len())].to_vec(),
-    };
-    let b = TrainSeq {
-        memberships: q.memberships[cut..].to_vec(),
-        gamma: q.gamma[cut..].to_vec(),
-        xi: q.xi[cut.min(q.xi.len())..].to_vec(),
-    };
-    (a, b)
-}
-
 /// Chooses the CRF's L2 strength by validation: trains on the first 80% of every training
 /// sequence and scores the last 20% with the CRF's own objective (expected log-likelihood of
 /// the HMM posteriors, no penalty), for each value of [`L2_GRID`]. How much to regularize
@@ -344,15 +322,23 @@ pub fn choose_l2(
     let (fit_part, held): (Vec<TrainSeq>, Vec<TrainSeq>) = base
         .train
         .iter()
-        .filter(|q| q.memberships.len() >= 10)
-        .map(|q| split_seq(q, q.memberships.len() * 4 / 5))
+        .zip(&base.y)
+        .filter(|(q, _)| q.memberships.len() >= 10)
+        .map(|(q, y)| {
+            let cut = q.memberships.len() * 4 / 5;
+            let part = |r: std::ops::Range<usize>| {
+                TrainSeq::new(q.memberships[r.clone()].to_vec(), base.hmm.posterior(&y[r]))
+            };
+            (part(0..cut), part(cut..q.memberships.len()))
+        })
         .unzip();
     let held_steps: usize = held.iter().map(|q| q.memberships.len()).sum();
     let fit_steps: usize = fit_part.iter().map(|q| q.memberships.len()).sum();
     if held_steps == 0 {
         return Ok((1e-2, f64::NAN));
     }
-    let (s, k) = (base.hmm.states(), base.gmm.components.len());
+    let k = base.gmm.components.len();
+    let center = Crf::prior(&base.state_prior, k, window);
     let mut best = (L2_GRID[0], f64::NEG_INFINITY);
     for &l2 in &L2_GRID {
         let cfg = CrfConfig {
@@ -360,8 +346,8 @@ pub fn choose_l2(
             l2: l2 * fit_steps as f64,
             ..CrfConfig::default()
         };
-        let (crf, _) = Crf::fit(&fit_part, s, k, &cfg).map_err(FitError::Crf)?;
-        let score = crf.objective_and_gradient(&held, 0.0).0 / held_steps as f64;
+        let (crf, _) = Crf::fit(&fit_part, &center, None, &cfg).map_err(FitError::Crf)?;
+        let score = crf.expected_log_likelihood(&held) / held_steps as f64;
         log(&format!(
             "crf: window {window}, l2 {l2}: held-out objective {score:.4} per step"
         ));
@@ -388,10 +374,11 @@ pub fn fit_crf(
     report.l2 = l2;
     // `l2` is per training step: the objective is a sum over steps, so the penalty scales
     // with them and the regularization strength does not depend on the corpus size.
+    let center = Crf::prior(&base.state_prior, base.gmm.components.len(), window);
     let (crf, crep) = Crf::fit(
         &base.train,
-        base.hmm.states(),
-        base.gmm.components.len(),
+        &center,
+        None,
         &CrfConfig {
             window,
             l2: l2 * report.steps.max(1) as f64,
