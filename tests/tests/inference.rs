@@ -50,7 +50,7 @@ fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
     let (seqs, segs) = sequences(&corpus, None);
     for states in [4usize, 12] {
         let cfg = FitConfig {
-            states,
+            states: Some(states),
             ..FitConfig::default()
         };
         let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
@@ -102,7 +102,7 @@ fn model_file_round_trips_and_refuses_other_versions() {
         &seqs,
         &segs,
         &FitConfig {
-            states: 4,
+            states: Some(4),
             ..FitConfig::default()
         },
         &|_| {},
@@ -147,7 +147,7 @@ fn too_little_data_for_the_states_says_what_to_change() {
         &seqs,
         &segs,
         &FitConfig {
-            states: 25,
+            states: Some(25),
             ..FitConfig::default()
         },
         &|_| {},
@@ -183,11 +183,10 @@ fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
         write_corpus(&params, dir, |_, _| {}).unwrap();
     }
     let mut args = eval_args(a.path().to_str().unwrap(), b.path().to_str().unwrap());
-    args.model.states = 4;
-    let (rows, extras, ari) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
-    eprintln!("{extras}");
-    assert_eq!(rows.len(), 5);
-    for r in &rows {
+    args.model.states = Some(4);
+    let report = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
+    assert_eq!(report.rows.len(), 5);
+    for r in &report.rows {
         eprintln!(
             "W={}: crf {:.3} hmm {:.3} prior {:.3}",
             r.window, r.crf, r.hmm, r.prior
@@ -199,7 +198,9 @@ fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
         );
     }
     // The HMM's states on the training corpus recover the planted ones.
-    let ari = ari.expect("truth.json is next to the training corpus");
+    let (ari, _) = report
+        .ari
+        .expect("truth.json is next to the training corpus");
     assert!(ari >= 0.7, "ARI {ari}");
 }
 
@@ -214,10 +215,9 @@ fn fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window() {
     args.train_span = Some((0.0, 40.0));
     args.test_span = Some((40.0, 50.0));
     for states in [4usize, 8] {
-        args.model.states = states;
-        let (rows, extras, _) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
-        eprintln!("S={states}: {extras}");
-        for r in &rows {
+        args.model.states = Some(states);
+        let report = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
+        for r in &report.rows {
             eprintln!(
                 "  W={}: crf {:.3} hmm {:.3} prior {:.3}",
                 r.window, r.crf, r.hmm, r.prior

@@ -11,4 +11,5 @@ pub mod gmm;
 pub mod hmm;
 pub mod model;
 pub mod quantize;
+pub mod select;
 pub mod train;
