@@ -14,10 +14,11 @@
 //!   overlaps, so the training steps that overlap any segment a held-out block touches are
 //!   *purged* (dropped from training), or the held-out kinematics would leak into training.
 //!   The kinematic normalization is the corpus-wide one (a per-dimension affine map).
-//! - **One standard error**: the standard error is that of the mean over five contiguous
-//!   blocks of the held-out steps (the folds, or five parts of the single block). Each choice
-//!   takes the simplest candidate whose score is within one standard error of the best: fewer
-//!   states, fewer clusters, stronger L2, stronger lag penalty. Data too small to tell models
+//! - **One standard error**: each choice takes the simplest candidate whose score is within one
+//!   standard error of the best: fewer states, fewer clusters, stronger L2, stronger lag
+//!   penalty. The standard error is that of the *paired* difference to the best, over five
+//!   contiguous blocks of the held-out steps (the folds, or five parts of the single block):
+//!   blocks differ in level far more than candidates do, and that level is common to all. Data too small to tell models
 //!   apart therefore gives a small, strongly regularized model, close to the prior rather than
 //!   worse than it.
 //! - At least two states are chosen: S = 1 is scored and shown but never chosen (a
@@ -74,7 +75,7 @@ pub struct Point {
     pub lag_penalty: f64,
     /// Mean held-out log-likelihood per step.
     pub mean: f64,
-    /// Its standard error.
+    /// Standard error of its difference to the best candidate of its curve.
     pub se: f64,
 }
 
@@ -105,7 +106,8 @@ impl fmt::Display for Selection {
         writeln!(
             f,
             "model selection: mean held-out log-likelihood per step +- standard error \
-             ({} fold(s), {} held-out steps); * = chosen (simplest within one standard error)",
+             (standard error of the difference to the best; {} fold(s), {} held-out steps); \
+             * = chosen (simplest within one standard error)",
             self.folds, self.held_steps
         )?;
         for c in &self.curves {
@@ -203,7 +205,7 @@ pub fn folds(seqs: &[Sequence]) -> Vec<(Vec<Sequence>, Vec<Sequence>)> {
         .collect()
 }
 
-/// Mean and standard error over five contiguous blocks of `scores`.
+/// Mean of `scores` and the standard error of that mean from five contiguous blocks.
 fn mean_se(scores: &[f64]) -> (f64, f64) {
     let n = scores.len();
     if n == 0 {
@@ -224,9 +226,12 @@ fn mean_se(scores: &[f64]) -> (f64, f64) {
     (mean, (var / m).sqrt())
 }
 
-/// Index of the simplest point (lowest index) within one standard error of the best among
-/// `eligible`.
-fn one_se(points: &[Point], eligible: impl Fn(&Point) -> bool) -> usize {
+/// Chooses among `points` (simplest first) with their per-step held-out scores: the simplest
+/// eligible point whose mean is within one standard error of the best eligible one. The
+/// standard error is that of the *paired* difference to the best (blocks differ in level far
+/// more than candidates do, and the level is common to all). Sets every point's `se` to that
+/// of its difference to the best.
+fn one_se(points: &mut [Point], scores: &[Vec<f64>], eligible: impl Fn(&Point) -> bool) -> usize {
     let best = points
         .iter()
         .enumerate()
@@ -236,10 +241,17 @@ fn one_se(points: &[Point], eligible: impl Fn(&Point) -> bool) -> usize {
     let Some(best) = best else {
         return points.iter().position(&eligible).unwrap_or(0);
     };
-    let bar = points[best].mean - points[best].se;
+    for (i, p) in points.iter_mut().enumerate() {
+        let diff: Vec<f64> = scores[i]
+            .iter()
+            .zip(&scores[best])
+            .map(|(a, b)| a - b)
+            .collect();
+        p.se = mean_se(&diff).1;
+    }
     points
         .iter()
-        .position(|p| eligible(p) && p.mean >= bar)
+        .position(|p| eligible(p) && p.mean >= points[best].mean - p.se)
         .unwrap_or(best)
 }
 
@@ -294,7 +306,7 @@ impl Selector<'_> {
         k: usize,
         w: usize,
         regs: &[(f64, f64)],
-    ) -> Result<Vec<Point>, FitError> {
+    ) -> Result<(Vec<Point>, Vec<Vec<f64>>), FitError> {
         let mut scores: Vec<Vec<f64>> = vec![Vec::new(); regs.len()];
         for f in 0..self.folds.len() {
             let (hmm, prior) = self.hmm(f, s)?;
@@ -320,22 +332,20 @@ impl Selector<'_> {
                 warm = Some(crf);
             }
         }
-        Ok(regs
+        let points = regs
             .iter()
             .zip(&scores)
-            .map(|(&(l2, lag_penalty), sc)| {
-                let (mean, se) = mean_se(sc);
-                Point {
-                    states: s,
-                    clusters: k,
-                    window: w,
-                    l2,
-                    lag_penalty,
-                    mean,
-                    se,
-                }
+            .map(|(&(l2, lag_penalty), sc)| Point {
+                states: s,
+                clusters: k,
+                window: w,
+                l2,
+                lag_penalty,
+                mean: mean_se(sc).0,
+                se: 0.0,
             })
-            .collect())
+            .collect();
+        Ok((points, scores))
     }
 
     fn log_curve(&self, c: &Curve) {
@@ -435,14 +445,16 @@ pub fn choose(
         Some(s) => s,
         None => {
             let k = cfg.clusters.unwrap_or(DEFAULT_CLUSTERS);
-            let mut points = Vec::new();
+            let (mut points, mut scores) = (Vec::new(), Vec::new());
             for &s in STATE_GRID
                 .iter()
                 .filter(|&&s| s <= MAX_STATES && (s == 1 || min_train >= 10 * s.max(1)))
             {
-                points.extend(sel.score(s, k, cfg.window, &[default_reg])?);
+                let (p, sc) = sel.score(s, k, cfg.window, &[default_reg])?;
+                points.extend(p);
+                scores.extend(sc);
             }
-            let chosen = one_se(&points, |p| p.states >= 2);
+            let chosen = one_se(&mut points, &scores, |p| p.states >= 2);
             let c = Curve {
                 what: "states",
                 points,
@@ -457,14 +469,16 @@ pub fn choose(
     let clusters = match cfg.clusters {
         Some(k) => k,
         None => {
-            let mut points = Vec::new();
+            let (mut points, mut scores) = (Vec::new(), Vec::new());
             for &k in CLUSTER_GRID
                 .iter()
                 .filter(|&&k| k <= MAX_CLUSTERS && min_train >= 20 * k)
             {
-                points.extend(sel.score(states, k, cfg.window, &[default_reg])?);
+                let (p, sc) = sel.score(states, k, cfg.window, &[default_reg])?;
+                points.extend(p);
+                scores.extend(sc);
             }
-            let chosen = one_se(&points, |_| true);
+            let chosen = one_se(&mut points, &scores, |_| true);
             let c = Curve {
                 what: "clusters",
                 points,
@@ -479,7 +493,12 @@ pub fn choose(
     let mut regularization = Vec::new();
     for &w in windows {
         let l2s: Vec<f64> = cfg.l2.map_or(L2_GRID.to_vec(), |v| vec![v]);
-        let lags: Vec<f64> = cfg.lag_penalty.map_or(LAG_GRID.to_vec(), |v| vec![v]);
+        // A one-step window has no lagged weights: its lag penalty is moot.
+        let lags: Vec<f64> = match cfg.lag_penalty {
+            Some(v) => vec![v],
+            None if w == 1 => vec![1.0],
+            None => LAG_GRID.to_vec(),
+        };
         // Simplest first: strongest L2, then strongest lag penalty.
         let regs: Vec<(f64, f64)> = l2s
             .iter()
@@ -489,8 +508,8 @@ pub fn choose(
             regularization.push(regs[0]);
             continue;
         }
-        let points = sel.score(states, clusters, w, &regs)?;
-        let chosen = one_se(&points, |_| true);
+        let (mut points, scores) = sel.score(states, clusters, w, &regs)?;
+        let chosen = one_se(&mut points, &scores, |_| true);
         let c = Curve {
             what: "regularization",
             points,
@@ -560,7 +579,7 @@ mod tests {
 
     #[test]
     fn one_se_takes_the_simplest_close_candidate() {
-        let p = |states, mean, se| Point {
+        let p = |states, mean| Point {
             states,
             clusters: 2,
             window: 1,
