@@ -586,16 +586,23 @@ mod tests {
             l2: 0.1,
             lag_penalty: 1.0,
             mean,
-            se,
+            se: 0.0,
         };
-        let pts = [
-            p(1, 0.0, 0.1),
-            p(2, 1.0, 0.1),
-            p(3, 1.25, 0.1),
-            p(4, 1.3, 0.1),
-        ];
-        // Best 1.3 +- 0.1: S=3 (1.25) is the simplest within; S=1 never eligible.
-        assert_eq!(pts[one_se(&pts, |q| q.states >= 2)].states, 3);
+        let mut pts = [p(1, 0.0), p(2, 1.0), p(3, 1.25), p(4, 1.3)];
+        // Per-step scores: S=3 is 0.05 below S=4 on average with a spread of +-0.1 between
+        // blocks, so within one standard error; S=2 is 0.3 below everywhere.
+        let noise = [0.1, 0.1, -0.1, -0.1, 0.1, 0.1, -0.1, -0.1, 0.1, 0.1];
+        let scores: Vec<Vec<f64>> = pts
+            .iter()
+            .map(|q| {
+                (0..10)
+                    .map(|i| q.mean + if q.states == 3 { noise[i] } else { 0.0 })
+                    .collect()
+            })
+            .collect();
+        let chosen = one_se(&mut pts, &scores, |q| q.states >= 2);
+        assert_eq!(pts[chosen].states, 3, "{pts:?}");
+        assert_eq!(pts[3].se, 0.0);
         assert_eq!(mean_se(&[1.0; 10]), (1.0, 0.0));
     }
 }
