@@ -42,6 +42,32 @@ fn l1_per_step(model: &InferenceModel, seq: &Sequence) -> Vec<f64> {
 }
 
 #[test]
+fn limbs_measure_the_same_arm_on_both_zeroeggs_skeletons_and_bandais_shorter_one() {
+    use gesture_trainer::motion::{analyze, read_bvh, EffectorSpec, SegmentParams};
+    let Some(root) = e2e_tests::shared_data(
+        "limbs_measure_the_same_arm_on_both_zeroeggs_skeletons_and_bandais_shorter_one",
+        "",
+    ) else {
+        return;
+    };
+    for (file, want) in [
+        ("zeroeggs-067-speech2/067_Speech_2_first50s.bvh", 53.5),
+        ("zeroeggs-001-neutral-9joint/001_Neutral_0_x_1_0.bvh", 53.5),
+        (
+            "bandai-namco-gestures/dataset-1/dataset-1_bow_active_001.bvh",
+            46.6,
+        ),
+    ] {
+        let m = read_bvh(&root.join(file)).unwrap();
+        let a = analyze(&m, &EffectorSpec::default(), &SegmentParams::default()).unwrap();
+        let l = a.limb_length;
+        assert!((l - want).abs() < 0.1, "{file}: limb {l} cm, want {want}");
+        // Heights above the shoulder in limb units: hands between hanging and overhead.
+        assert!(a.kinematics.iter().all(|k| (0.0..=2.0).contains(&k.h)));
+    }
+}
+
+#[test]
 fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
     let Some(dir) = zeroeggs("runtime_belief_matches_float_on_every_step_of_the_real_take") else {
         return;
@@ -119,13 +145,23 @@ fn model_file_round_trips_and_refuses_other_versions() {
         model.crf.beliefs(&float_memberships(&model.gmm, &seqs[0]))
     );
     // Another version is refused with a message saying what to do.
-    let text = std::fs::read_to_string(&path)
-        .unwrap()
-        .replace("\"version\": 1", "\"version\": 99");
-    std::fs::write(&path, text).unwrap();
+    let current = format!(
+        "\"version\": {}",
+        gesture_trainer::inference::model::VERSION
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains(&current));
+    std::fs::write(&path, text.replace(&current, "\"version\": 99")).unwrap();
     let err = InferenceModel::load(&path).unwrap_err().to_string();
     assert!(
         err.contains("version 99") && err.contains("retrain"),
+        "{err}"
+    );
+    // Version 1 (skeleton units) is refused with the reason.
+    std::fs::write(&path, text.replace(&current, "\"version\": 1")).unwrap();
+    let err = InferenceModel::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("limb lengths") && err.contains("retrain"),
         "{err}"
     );
     std::fs::write(&path, b"{ not json").unwrap();
