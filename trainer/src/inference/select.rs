@@ -50,7 +50,7 @@ pub const STATE_GRID: [usize; 10] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32];
 /// Candidate numbers of prosody clusters.
 pub const CLUSTER_GRID: [usize; 7] = [2, 3, 4, 6, 8, 12, 16];
 /// Candidate L2 strengths per training step, simplest (strongest) first.
-pub const L2_GRID: [f64; 6] = [0.3, 0.1, 0.03, 0.01, 0.003, 0.001];
+pub const L2_GRID: [f64; 8] = [0.3, 0.1, 0.03, 0.01, 0.003, 0.001, 3e-4, 1e-4];
 /// Candidate lag penalties, simplest (strongest) first.
 pub const LAG_GRID: [f64; 3] = [100.0, 10.0, 1.0];
 /// Clusters while S is chosen, when K is open too.
