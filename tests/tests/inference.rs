@@ -88,10 +88,58 @@ fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
     }
 }
 
+/// The per-step features as the runtime's module docs define them, in f64: relative log2 F0
+/// against the running mean over voiced syllables, relative intensity / 10 dB against the
+/// running mean over syllables (clamped to [-6, 2]), ln length; running means weighted
+/// `1 / min(n, MEMORY)`.
+fn features_by_definition(
+    steps: &[gesture_runtime::prosody::Step],
+) -> Vec<(Option<f64>, f64, f64)> {
+    use gesture_runtime::inference::features::MEMORY;
+    use gesture_runtime::prosody::StepKind;
+    let (mut ref_f0, mut n_f0, mut ref_db, mut n_db) = (7.0f64, 0u32, 60.0f64, 0u32);
+    steps
+        .iter()
+        .map(|s| {
+            let pause = s.kind == StepKind::Pause;
+            let f0 = s.f0_hz.filter(|f| *f > 1.0).map(|f| {
+                let l = (f as f64).log2();
+                if !pause {
+                    n_f0 += 1;
+                    ref_f0 += (l - ref_f0) / n_f0.min(MEMORY) as f64;
+                }
+                l - ref_f0
+            });
+            let db = s.intensity_db as f64;
+            if !pause && db > -100.0 {
+                n_db += 1;
+                ref_db += (db - ref_db) / n_db.min(MEMORY) as f64;
+            }
+            let len = (s.length_s() as f64).max(0.01);
+            (f0, ((db - ref_db) / 10.0).clamp(-6.0, 2.0), len.ln())
+        })
+        .collect()
+}
+
 #[test]
-fn features_fed_to_the_trainer_are_the_runtimes() {
-    // The aligned steps' features must equal what the runtime normalizer gives for the same
-    // steps, so training and device features cannot drift apart.
+fn features_fed_to_the_trainer_match_their_definition() {
+    use gesture_runtime::prosody::{Step, StepKind};
+    // Known answer by hand: syllables at 100 Hz / 60 dB, 200 Hz / 70 dB, then a pause.
+    let syl = |f0: f32, db: f32| Step {
+        kind: StepKind::Syllable,
+        start_frame: 0,
+        end_frame: 20,
+        f0_hz: Some(f0),
+        intensity_db: db,
+    };
+    let mut n = StepNormalizer::new();
+    let a = n.push(&syl(100.0, 60.0));
+    let b = n.push(&syl(200.0, 70.0));
+    assert_eq!(a.f0, Some(0.0)); // the first voiced syllable is its own reference
+    assert!((b.f0.unwrap() - 0.5).abs() < 1e-6); // log2 200 - mean(log2 100, log2 200)
+    assert!((b.obs[0] - 0.5).abs() < 1e-6); // (70 - 65) / 10
+    assert!((b.obs[1] - 0.2f32.ln()).abs() < 1e-6); // 20 frames of 10 ms
+                                                    // Every aligned step of a synthetic corpus carries the features the definition gives.
     let dir = tempfile::tempdir().unwrap();
     let params = SynthParams {
         minutes: 1.0,
@@ -99,17 +147,24 @@ fn features_fed_to_the_trainer_are_the_runtimes() {
         take_seconds: 60.0,
     };
     write_corpus(&params, dir.path(), |_, _| {}).unwrap();
-
     let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
     let t = &corpus.takes[0];
-    let mut n = StepNormalizer::new();
-    let device: Vec<_> = t.steps.iter().map(|s| (s.start_frame, n.push(s))).collect();
+    let want = features_by_definition(&t.steps);
+    assert!(t.aligned.len() > 100);
     for a in &t.aligned {
-        let d = device
+        let i = t
+            .steps
             .iter()
-            .find(|(f, _)| *f == a.step.start_frame)
+            .position(|s| s.start_frame == a.step.start_frame)
             .unwrap();
-        assert_eq!(d.1, a.features);
+        let (f0, rel, len) = want[i];
+        match (a.features.f0, f0) {
+            (Some(x), Some(y)) => assert!((x as f64 - y).abs() < 1e-4, "step {i}: f0 {x} vs {y}"),
+            (None, None) => {}
+            (x, y) => panic!("step {i}: voicing {x:?} vs {y:?}"),
+        }
+        assert!((a.features.obs[0] as f64 - rel).abs() < 1e-4, "step {i}");
+        assert!((a.features.obs[1] as f64 - len).abs() < 1e-4, "step {i}");
     }
 }
 
