@@ -85,7 +85,13 @@ pub fn evaluate(a: &EvalArgs) -> Result<EvalReport, CliError> {
     };
     let (train_seqs, segs) = sequences(&train, a.train_span);
     let (test_seqs, _) = sequences(&test, a.test_span);
-    let cfg = a.model.config(a.windows.first().copied().unwrap_or(4));
+    // S and K are chosen with the paper's window (4) when it is compared, as `fit` does.
+    let w = if a.windows.contains(&4) {
+        4
+    } else {
+        a.windows.first().copied().unwrap_or(4)
+    };
+    let cfg = a.model.config(w);
     let (train_runs, test_runs) = (planted_runs(&a.train), planted_runs(&a.test));
     Ok(eval::evaluate(
         (&train_seqs, &segs),
