@@ -557,6 +557,35 @@ mod tests {
     }
 
     #[test]
+    fn the_prior_crf_believes_the_prior_and_heavy_l2_stays_there() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let (s, k, w) = (3, 4, 3);
+        let prior = [0.6, 0.3, 0.1];
+        let center = Crf::prior(&prior, k, w);
+        let q = random_seq(&mut rng, 30, s, k);
+        for b in center.beliefs(&q.memberships) {
+            for (x, p) in b.iter().zip(&prior) {
+                assert!((x - p).abs() < 1e-12, "{b:?}");
+            }
+        }
+        // An overwhelming penalty toward the prior CRF leaves the belief at the prior (a
+        // penalty toward zero would leave it uniform).
+        let seqs = vec![random_seq(&mut rng, 40, s, k)];
+        let cfg = CrfConfig {
+            window: w,
+            l2: 1e9,
+            lag_penalty: 10.0,
+            ..CrfConfig::default()
+        };
+        let (crf, _) = Crf::fit(&seqs, &center, None, &cfg).unwrap();
+        for b in crf.beliefs(&q.memberships) {
+            for (x, p) in b.iter().zip(&prior) {
+                assert!((x - p).abs() < 1e-6, "{b:?}");
+            }
+        }
+    }
+
+    #[test]
     fn log_partition_matches_enumeration() {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         let (s, k, w) = (2, 3, 2);
