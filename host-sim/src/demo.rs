@@ -134,8 +134,8 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
         .map_err(at("loading the corpus"))?;
     let (seqs, segs) = sequences(&c, None);
     let cfg = FitConfig {
-        states: params.states,
-        clusters: 8,
+        states: Some(params.states),
+        clusters: Some(8),
         window: 4,
         restarts: 8,
         ..FitConfig::default()

@@ -45,8 +45,8 @@ fn setup() -> &'static Setup {
         let c = load_corpus(std::slice::from_ref(&corpus), &LoadOptions::default()).unwrap();
         let (seqs, segs) = sequences(&c, None);
         let cfg = FitConfig {
-            states: 4,
-            clusters: 4,
+            states: Some(4),
+            clusters: Some(4),
             window: 4,
             restarts: 2,
             l2: Some(1e-3),

@@ -42,6 +42,32 @@ fn l1_per_step(model: &InferenceModel, seq: &Sequence) -> Vec<f64> {
 }
 
 #[test]
+fn limbs_measure_the_same_arm_on_both_zeroeggs_skeletons_and_bandais_shorter_one() {
+    use gesture_trainer::motion::{analyze, read_bvh, EffectorSpec, SegmentParams};
+    let Some(root) = e2e_tests::shared_data(
+        "limbs_measure_the_same_arm_on_both_zeroeggs_skeletons_and_bandais_shorter_one",
+        "",
+    ) else {
+        return;
+    };
+    for (file, want) in [
+        ("zeroeggs-067-speech2/067_Speech_2_first50s.bvh", 53.5),
+        ("zeroeggs-001-neutral-9joint/001_Neutral_0_x_1_0.bvh", 53.5),
+        (
+            "bandai-namco-gestures/dataset-1/dataset-1_bow_active_001.bvh",
+            46.6,
+        ),
+    ] {
+        let m = read_bvh(&root.join(file)).unwrap();
+        let a = analyze(&m, &EffectorSpec::default(), &SegmentParams::default()).unwrap();
+        let l = a.limb_length;
+        assert!((l - want).abs() < 0.1, "{file}: limb {l} cm, want {want}");
+        // Heights above the shoulder in limb units: hands between hanging and overhead.
+        assert!(a.kinematics.iter().all(|k| (0.0..=2.0).contains(&k.h)));
+    }
+}
+
+#[test]
 fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
     let Some(dir) = zeroeggs("runtime_belief_matches_float_on_every_step_of_the_real_take") else {
         return;
@@ -50,7 +76,7 @@ fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
     let (seqs, segs) = sequences(&corpus, None);
     for states in [4usize, 12] {
         let cfg = FitConfig {
-            states,
+            states: Some(states),
             ..FitConfig::default()
         };
         let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
@@ -62,10 +88,58 @@ fn runtime_belief_matches_float_on_every_step_of_the_real_take() {
     }
 }
 
+/// The per-step features as the runtime's module docs define them, in f64: relative log2 F0
+/// against the running mean over voiced syllables, relative intensity / 10 dB against the
+/// running mean over syllables (clamped to [-6, 2]), ln length; running means weighted
+/// `1 / min(n, MEMORY)`.
+fn features_by_definition(
+    steps: &[gesture_runtime::prosody::Step],
+) -> Vec<(Option<f64>, f64, f64)> {
+    use gesture_runtime::inference::features::MEMORY;
+    use gesture_runtime::prosody::StepKind;
+    let (mut ref_f0, mut n_f0, mut ref_db, mut n_db) = (7.0f64, 0u32, 60.0f64, 0u32);
+    steps
+        .iter()
+        .map(|s| {
+            let pause = s.kind == StepKind::Pause;
+            let f0 = s.f0_hz.filter(|f| *f > 1.0).map(|f| {
+                let l = (f as f64).log2();
+                if !pause {
+                    n_f0 += 1;
+                    ref_f0 += (l - ref_f0) / n_f0.min(MEMORY) as f64;
+                }
+                l - ref_f0
+            });
+            let db = s.intensity_db as f64;
+            if !pause && db > -100.0 {
+                n_db += 1;
+                ref_db += (db - ref_db) / n_db.min(MEMORY) as f64;
+            }
+            let len = (s.length_s() as f64).max(0.01);
+            (f0, ((db - ref_db) / 10.0).clamp(-6.0, 2.0), len.ln())
+        })
+        .collect()
+}
+
 #[test]
-fn features_fed_to_the_trainer_are_the_runtimes() {
-    // The aligned steps' features must equal what the runtime normalizer gives for the same
-    // steps, so training and device features cannot drift apart.
+fn features_fed_to_the_trainer_match_their_definition() {
+    use gesture_runtime::prosody::{Step, StepKind};
+    // Known answer by hand: syllables at 100 Hz / 60 dB, 200 Hz / 70 dB, then a pause.
+    let syl = |f0: f32, db: f32| Step {
+        kind: StepKind::Syllable,
+        start_frame: 0,
+        end_frame: 20,
+        f0_hz: Some(f0),
+        intensity_db: db,
+    };
+    let mut n = StepNormalizer::new();
+    let a = n.push(&syl(100.0, 60.0));
+    let b = n.push(&syl(200.0, 70.0));
+    assert_eq!(a.f0, Some(0.0)); // the first voiced syllable is its own reference
+    assert!((b.f0.unwrap() - 0.5).abs() < 1e-6); // log2 200 - mean(log2 100, log2 200)
+    assert!((b.obs[0] - 0.5).abs() < 1e-6); // (70 - 65) / 10
+    assert!((b.obs[1] - 0.2f32.ln()).abs() < 1e-6); // 20 frames of 10 ms
+                                                    // Every aligned step of a synthetic corpus carries the features the definition gives.
     let dir = tempfile::tempdir().unwrap();
     let params = SynthParams {
         minutes: 1.0,
@@ -73,17 +147,24 @@ fn features_fed_to_the_trainer_are_the_runtimes() {
         take_seconds: 60.0,
     };
     write_corpus(&params, dir.path(), |_, _| {}).unwrap();
-
     let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
     let t = &corpus.takes[0];
-    let mut n = StepNormalizer::new();
-    let device: Vec<_> = t.steps.iter().map(|s| (s.start_frame, n.push(s))).collect();
+    let want = features_by_definition(&t.steps);
+    assert!(t.aligned.len() > 100);
     for a in &t.aligned {
-        let d = device
+        let i = t
+            .steps
             .iter()
-            .find(|(f, _)| *f == a.step.start_frame)
+            .position(|s| s.start_frame == a.step.start_frame)
             .unwrap();
-        assert_eq!(d.1, a.features);
+        let (f0, rel, len) = want[i];
+        match (a.features.f0, f0) {
+            (Some(x), Some(y)) => assert!((x as f64 - y).abs() < 1e-4, "step {i}: f0 {x} vs {y}"),
+            (None, None) => {}
+            (x, y) => panic!("step {i}: voicing {x:?} vs {y:?}"),
+        }
+        assert!((a.features.obs[0] as f64 - rel).abs() < 1e-4, "step {i}");
+        assert!((a.features.obs[1] as f64 - len).abs() < 1e-4, "step {i}");
     }
 }
 
@@ -102,7 +183,7 @@ fn model_file_round_trips_and_refuses_other_versions() {
         &seqs,
         &segs,
         &FitConfig {
-            states: 4,
+            states: Some(4),
             ..FitConfig::default()
         },
         &|_| {},
@@ -119,13 +200,23 @@ fn model_file_round_trips_and_refuses_other_versions() {
         model.crf.beliefs(&float_memberships(&model.gmm, &seqs[0]))
     );
     // Another version is refused with a message saying what to do.
-    let text = std::fs::read_to_string(&path)
-        .unwrap()
-        .replace("\"version\": 1", "\"version\": 99");
-    std::fs::write(&path, text).unwrap();
+    let current = format!(
+        "\"version\": {}",
+        gesture_trainer::inference::model::VERSION
+    );
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains(&current));
+    std::fs::write(&path, text.replace(&current, "\"version\": 99")).unwrap();
     let err = InferenceModel::load(&path).unwrap_err().to_string();
     assert!(
         err.contains("version 99") && err.contains("retrain"),
+        "{err}"
+    );
+    // Version 1 (skeleton units) is refused with the reason.
+    std::fs::write(&path, text.replace(&current, "\"version\": 1")).unwrap();
+    let err = InferenceModel::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("limb lengths") && err.contains("retrain"),
         "{err}"
     );
     std::fs::write(&path, b"{ not json").unwrap();
@@ -147,7 +238,7 @@ fn too_little_data_for_the_states_says_what_to_change() {
         &seqs,
         &segs,
         &FitConfig {
-            states: 25,
+            states: Some(25),
             ..FitConfig::default()
         },
         &|_| {},
@@ -183,11 +274,10 @@ fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
         write_corpus(&params, dir, |_, _| {}).unwrap();
     }
     let mut args = eval_args(a.path().to_str().unwrap(), b.path().to_str().unwrap());
-    args.model.states = 4;
-    let (rows, extras, ari) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
-    eprintln!("{extras}");
-    assert_eq!(rows.len(), 5);
-    for r in &rows {
+    args.model.states = Some(4);
+    let report = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
+    assert_eq!(report.rows.len(), 5);
+    for r in &report.rows {
         eprintln!(
             "W={}: crf {:.3} hmm {:.3} prior {:.3}",
             r.window, r.crf, r.hmm, r.prior
@@ -199,7 +289,9 @@ fn fig4_on_synthetic_data_crf_beats_hmm_and_prior_and_states_are_recovered() {
         );
     }
     // The HMM's states on the training corpus recover the planted ones.
-    let ari = ari.expect("truth.json is next to the training corpus");
+    let (ari, _) = report
+        .ari
+        .expect("truth.json is next to the training corpus");
     assert!(ari >= 0.7, "ARI {ari}");
 }
 
@@ -214,10 +306,9 @@ fn fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window() {
     args.train_span = Some((0.0, 40.0));
     args.test_span = Some((40.0, 50.0));
     for states in [4usize, 8] {
-        args.model.states = states;
-        let (rows, extras, _) = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
-        eprintln!("S={states}: {extras}");
-        for r in &rows {
+        args.model.states = Some(states);
+        let report = gesture_trainer::cli::eval_inference::evaluate(&args).unwrap();
+        for r in &report.rows {
             eprintln!(
                 "  W={}: crf {:.3} hmm {:.3} prior {:.3}",
                 r.window, r.crf, r.hmm, r.prior

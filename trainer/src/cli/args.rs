@@ -72,22 +72,26 @@ impl ControlArgs {
 /// Model options shared by `fit` and `eval-inference`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelArgs {
-    /// Hidden states S.
-    #[arg(long, default_value_t = 12)]
-    pub states: usize,
-    /// Prosody clusters K.
-    #[arg(long, default_value_t = 12)]
-    pub clusters: usize,
+    /// Hidden states S (default: chosen by held-out likelihood).
+    #[arg(long)]
+    pub states: Option<usize>,
+    /// Prosody clusters K (default: chosen by held-out likelihood).
+    #[arg(long)]
+    pub clusters: Option<usize>,
     /// HMM restarts (run in parallel; EM finds better optima with more).
     #[arg(long, default_value_t = 16)]
     pub restarts: usize,
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// CRF L2 regularization per training step (default: chosen by validation on the last
-    /// 20% of each training take).
+    /// CRF L2 regularization per training step, toward the CRF that learned nothing (default:
+    /// chosen by held-out likelihood, per window).
     #[arg(long)]
     pub l2: Option<f64>,
+    /// Multiplier of the L2 strength on the CRF's older window steps (default: chosen by
+    /// held-out likelihood from 1, 10, 100).
+    #[arg(long)]
+    pub lag_penalty: Option<f64>,
     /// HMM stickiness: extra self-transition pseudo-count as a fraction of steps per state.
     #[arg(long, default_value_t = 0.0)]
     pub stickiness: f64,
@@ -104,6 +108,7 @@ impl ModelArgs {
             seed: self.seed,
             stickiness: self.stickiness,
             l2: self.l2,
+            lag_penalty: self.lag_penalty,
             ..Default::default()
         }
     }

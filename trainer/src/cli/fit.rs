@@ -46,14 +46,18 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
     let cfg = a.model.config(a.window);
     let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;
     model.save(&a.out)?;
+    if let Some(sel) = &report.selection {
+        outln!("{}", sel.to_string().trim_end())?;
+    }
     outln!(
-        "wrote {}: {}; fit {:.2} s (hmm {:.2}, gmm {:.2}, crf {:.2}), total {:.2} s",
+        "wrote {}: {}; fit {:.2} s (selection {:.2}, hmm {:.2}, gmm {:.2}, crf {:.2}), total {:.2} s",
         a.out.display(),
         model.summary,
         report.seconds.iter().sum::<f64>(),
         report.seconds[0],
         report.seconds[1],
         report.seconds[2],
+        report.seconds[3],
         start.elapsed().as_secs_f64()
     )?;
     Ok(())

@@ -1,6 +1,6 @@
-//! The remapped CRF (DESIGN.md, inference layer steps 3-4): a linear-chain CRF over the hidden
-//! states given the prosody cluster memberships, trained by maximum likelihood *of the fixed
-//! HMM posteriors*.
+//! The remapped CRF (docs/method.md, "Inference layer", steps 3-4): a linear-chain CRF over the
+//! hidden states given the prosody cluster memberships, trained by maximum likelihood *of the
+//! fixed HMM posteriors*.
 //!
 //! Score of a state path `q` given memberships `m_t` (K per step):
 //!
@@ -10,29 +10,52 @@
 //! p(q | x) = exp(s(q)) / Z(x)
 //! ```
 //!
-//! Training maximizes `sum_t E_{gamma, xi}[log p(q | x)] - (l2 / 2) |theta|^2`; its gradient is
-//! the expected features under the HMM posteriors minus those under the CRF (computed with the
-//! same scaled forward-backward as the HMM). L-BFGS (argmin, More-Thuente line search) does
-//! the optimization; sequences are evaluated in parallel.
+//! Training maximizes `sum_t E_{gamma, xi}[log p(q | x)] - penalty(theta)`; its gradient is the
+//! expected features under the HMM posteriors minus those under the CRF (computed with the same
+//! scaled forward-backward as the HMM, into reused buffers). L-BFGS (argmin, More-Thuente line
+//! search) does the optimization; cost and gradient come from one pass over the data (cached
+//! for the line search's paired calls); sequences are evaluated in parallel.
+//!
+//! ## Regularization: toward the prior, and harder on older window steps
+//!
+//! The penalty is `(l2 / 2) sum_p c_p (theta_p - theta0_p)^2`, where
+//!
+//! - `theta0` is [`Crf::prior`], the CRF that *learned nothing*: `init = ln pi`,
+//!   `trans[i, j] = ln pi_j`, no observation weights, whose online belief is the state prior
+//!   `pi` at every step. A plain L2 toward zero would pull an under-informed model toward the
+//!   *uniform* belief, which scores worse than the prior; pulling toward `theta0` means that
+//!   the more the data are regularized away, the closer the CRF gets to the prior, never below.
+//! - `c_p = 1` for initial, transition and current-step (`w = 0`) observation weights, and
+//!   `c_p = lag_penalty` (chosen from 1, 10, 100 on held-out data) for the older window steps
+//!   `w >= 1`. Each extra window step adds `S x K` weights that mostly re-count evidence the
+//!   forward chain already carries (the belief at `t - 1` was updated with `m_{t-1}`), so an
+//!   equally regularized longer window fits the training posteriors with over-confident online
+//!   beliefs and scores worse on held-out speech as `W` grows. Penalizing the lagged weights
+//!   separately lets them carry only what the chain does not, and a longer window then does no
+//!   worse than a short one.
 //!
 //! Online, the belief after step `t` is the normalized forward vector
 //! `alpha_t(j) ~ sum_i alpha_{t-1}(i) exp(trans[i,j] + phi_t(j))` ([`Crf::beliefs`]); the runtime's
 //! quantized forward step is checked against it.
+
+use std::sync::Mutex;
 
 use argmin::core::{CostFunction, Executor, Gradient, State};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::LBFGS;
 use rayon::prelude::*;
 
-use super::hmm::forward_backward;
+use super::hmm::{forward_backward_into, FbWork, Posterior};
 
 /// Training settings.
 #[derive(Clone, Copy, Debug)]
 pub struct CrfConfig {
     /// Window W: memberships of steps `t, t-1, ..., t-W+1` feed step `t`.
     pub window: usize,
-    /// L2 regularization strength.
+    /// L2 strength toward [`Crf::prior`] (absolute: the objective is a sum over steps).
     pub l2: f64,
+    /// Multiplier of `l2` on the observation weights of window steps `w >= 1`.
+    pub lag_penalty: f64,
     /// L-BFGS iteration cap.
     pub max_iter: u64,
 }
@@ -42,6 +65,7 @@ impl Default for CrfConfig {
         Self {
             window: 4,
             l2: 1e-2,
+            lag_penalty: 1.0,
             max_iter: 200,
         }
     }
@@ -52,10 +76,21 @@ impl Default for CrfConfig {
 pub struct TrainSeq {
     /// `m[t][k]`: cluster memberships of step `t`.
     pub memberships: Vec<Vec<f64>>,
-    /// HMM state posteriors `gamma[t][i]`.
-    pub gamma: Vec<Vec<f64>>,
-    /// HMM pairwise posteriors `xi[t][i * S + j]` for `t < T - 1`.
-    pub xi: Vec<Vec<f64>>,
+    /// HMM state posteriors, flat `gamma[t * S + i]`.
+    pub gamma: Vec<f64>,
+    /// HMM expected transition counts `xi_sum[i * S + j]`.
+    pub xi_sum: Vec<f64>,
+}
+
+impl TrainSeq {
+    /// From memberships and an HMM posterior.
+    pub fn new(memberships: Vec<Vec<f64>>, post: Posterior) -> Self {
+        Self {
+            memberships,
+            gamma: post.gamma,
+            xi_sum: post.xi_sum,
+        }
+    }
 }
 
 /// A trained CRF.
@@ -80,10 +115,20 @@ pub struct Crf {
 pub struct CrfReport {
     /// L-BFGS iterations.
     pub iterations: u64,
-    /// Final objective (expected log-likelihood minus the L2 term).
+    /// Final objective (expected log-likelihood minus the penalty).
     pub objective: f64,
     /// Why it stopped.
     pub termination: String,
+}
+
+/// Per-thread scratch of the objective.
+#[derive(Default)]
+struct Scratch {
+    phi: Vec<f64>,
+    init: Vec<f64>,
+    trans: Vec<f64>,
+    work: FbWork,
+    post: Posterior,
 }
 
 impl Crf {
@@ -97,6 +142,18 @@ impl Crf {
             trans: vec![0.0; states * states],
             obs: vec![0.0; states * window * clusters],
         }
+    }
+
+    /// The CRF whose online belief is `prior` at every step (see the module docs).
+    pub fn prior(prior: &[f64], clusters: usize, window: usize) -> Self {
+        let s = prior.len();
+        let ln: Vec<f64> = prior.iter().map(|p| p.max(1e-6).ln()).collect();
+        let mut c = Self::zeros(s, clusters, window);
+        c.init.copy_from_slice(&ln);
+        for i in 0..s {
+            c.trans[i * s..(i + 1) * s].copy_from_slice(&ln);
+        }
+        c
     }
 
     fn n_params(&self) -> usize {
@@ -123,61 +180,114 @@ impl Crf {
         }
     }
 
+    /// The same weights in a window of `window` steps (extra lags zero, missing ones dropped):
+    /// a warm start for another window.
+    pub fn rewindowed(&self, window: usize) -> Self {
+        let (s, k) = (self.states, self.clusters);
+        let mut c = Self::zeros(s, k, window);
+        c.init.copy_from_slice(&self.init);
+        c.trans.copy_from_slice(&self.trans);
+        for j in 0..s {
+            for w in 0..window.min(self.window) {
+                let (a, b) = ((j * window + w) * k, (j * self.window + w) * k);
+                c.obs[a..a + k].copy_from_slice(&self.obs[b..b + k]);
+            }
+        }
+        c
+    }
+
+    /// Penalty multiplier of every parameter (1, or `lag_penalty` for lagged observation
+    /// weights), in [`Crf::to_vec`] order.
+    fn penalty_scale(&self, lag_penalty: f64) -> Vec<f64> {
+        let (s, w_len, k) = (self.states, self.window, self.clusters);
+        let mut c = vec![1.0; self.n_params()];
+        let off = s + s * s;
+        for j in 0..s {
+            for w in 1..w_len {
+                let base = off + (j * w_len + w) * k;
+                c[base..base + k].fill(lag_penalty);
+            }
+        }
+        c
+    }
+
+    /// `phi[t * S + j]`, the observation score of state `j` at step `t`, into `out`.
+    fn observation_scores_into(&self, m: &[Vec<f64>], out: &mut Vec<f64>) {
+        let (s, w_len, k) = (self.states, self.window, self.clusters);
+        out.clear();
+        out.resize(m.len() * s, 0.0);
+        for t in 0..m.len() {
+            let row = &mut out[t * s..(t + 1) * s];
+            for (j, r) in row.iter_mut().enumerate() {
+                let mut acc = 0.0;
+                for w in 0..w_len.min(t + 1) {
+                    let mt = &m[t - w];
+                    let wts = &self.obs[(j * w_len + w) * k..(j * w_len + w + 1) * k];
+                    for kk in 0..k {
+                        acc += wts[kk] * mt[kk];
+                    }
+                }
+                *r = acc;
+            }
+        }
+    }
+
     /// `phi[t][j]`, the observation score of state `j` at step `t`.
     pub fn observation_scores(&self, m: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        let (s, w_len, k) = (self.states, self.window, self.clusters);
-        (0..m.len())
-            .map(|t| {
-                (0..s)
-                    .map(|j| {
-                        let mut acc = 0.0;
-                        for w in 0..w_len.min(t + 1) {
-                            let mt = &m[t - w];
-                            let base = (j * w_len + w) * k;
-                            for kk in 0..k {
-                                acc += self.obs[base + kk] * mt[kk];
-                            }
-                        }
-                        acc
-                    })
-                    .collect()
-            })
+        let mut flat = Vec::new();
+        self.observation_scores_into(m, &mut flat);
+        flat.chunks_exact(self.states.max(1))
+            .map(<[f64]>::to_vec)
             .collect()
     }
 
-    /// Posterior marginals and `log Z` under the CRF for one sequence.
-    fn marginals(&self, m: &[Vec<f64>]) -> super::hmm::Posterior {
-        let phi = self.observation_scores(m);
+    /// Posterior marginals and `log Z` under the CRF for one sequence, into `sc.post` (the
+    /// observation scores stay in `sc.phi`).
+    fn marginals_into(&self, m: &[Vec<f64>], sc: &mut Scratch) {
+        self.observation_scores_into(m, &mut sc.phi);
         let tmax = self.trans.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
         let imax = self.init.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-        let trans: Vec<f64> = self.trans.iter().map(|v| (v - tmax).exp()).collect();
-        let init: Vec<f64> = self.init.iter().map(|v| (v - imax).exp()).collect();
-        let mut post = forward_backward(&init, &trans, &phi);
-        post.log_likelihood += imax + tmax * m.len().saturating_sub(1) as f64;
-        post
+        sc.trans.clear();
+        sc.trans.extend(self.trans.iter().map(|v| (v - tmax).exp()));
+        sc.init.clear();
+        sc.init.extend(self.init.iter().map(|v| (v - imax).exp()));
+        forward_backward_into(&sc.init, &sc.trans, &sc.phi, &mut sc.work, &mut sc.post);
+        sc.post.log_likelihood += imax + tmax * m.len().saturating_sub(1) as f64;
+    }
+
+    fn marginals(&self, m: &[Vec<f64>]) -> Posterior {
+        let mut sc = Scratch::default();
+        self.marginals_into(m, &mut sc);
+        sc.post
     }
 
     /// Offline posteriors `P(q_t | x_1..T)` (forward-backward over the whole sequence): what
     /// the offline reference may use, seeing the future.
     pub fn posteriors(&self, m: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        self.marginals(m).gamma
+        self.marginals(m)
+            .gamma_rows()
+            .map(<[f64]>::to_vec)
+            .collect()
     }
 
     /// Online beliefs: the normalized forward vector after each step.
     pub fn beliefs(&self, m: &[Vec<f64>]) -> Vec<Vec<f64>> {
         let s = self.states;
-        let phi = self.observation_scores(m);
+        let mut phi = Vec::new();
+        self.observation_scores_into(m, &mut phi);
         let mut out: Vec<Vec<f64>> = Vec::with_capacity(m.len());
-        for (t, ph) in phi.iter().enumerate() {
-            let mut logit = vec![0.0; s];
+        let mut logit = vec![0.0; s];
+        let mut terms = vec![0.0; s];
+        for t in 0..m.len() {
+            let ph = &phi[t * s..(t + 1) * s];
             for j in 0..s {
                 logit[j] = if t == 0 {
                     self.init[j] + ph[j]
                 } else {
                     let prev = &out[t - 1];
-                    let terms: Vec<f64> = (0..s)
-                        .map(|i| prev[i].max(1e-300).ln() + self.trans[i * s + j])
-                        .collect();
+                    for i in 0..s {
+                        terms[i] = prev[i].max(1e-300).ln() + self.trans[i * s + j];
+                    }
                     super::gaussian::log_sum_exp(&terms) + ph[j]
                 };
             }
@@ -187,84 +297,102 @@ impl Crf {
         out
     }
 
-    /// Objective (to maximize) and its gradient over the training sequences.
-    pub fn objective_and_gradient(&self, seqs: &[TrainSeq], l2: f64) -> (f64, Vec<f64>) {
+    /// Expected log-likelihood of the HMM posteriors and its gradient, summed over `seqs`
+    /// (no penalty).
+    fn data_term(&self, seqs: &[TrainSeq]) -> (f64, Vec<f64>) {
         let (s, w_len, k) = (self.states, self.window, self.clusters);
         let n = self.n_params();
-        let per_seq: Vec<(f64, Vec<f64>)> = seqs
-            .par_iter()
-            .map(|q| {
-                let mut g = vec![0.0; n];
-                let t_len = q.memberships.len();
-                if t_len == 0 {
-                    return (0.0, g);
-                }
-                let post = self.marginals(&q.memberships);
-                let phi = self.observation_scores(&q.memberships);
-                // Expected score under the HMM posteriors.
-                let mut e_score = 0.0;
-                for j in 0..s {
-                    e_score += q.gamma[0][j] * self.init[j];
-                }
-                for x in &q.xi {
-                    for (a, b) in x.iter().zip(&self.trans) {
-                        e_score += a * b;
+        let off = s + s * s;
+        let zero = || (0.0, vec![0.0; n]);
+        seqs.par_iter()
+            .fold(
+                || (zero(), Scratch::default()),
+                |((mut obj, mut g), mut sc), q| {
+                    let t_len = q.memberships.len();
+                    if t_len == 0 {
+                        return ((obj, g), sc);
                     }
-                }
-                for t in 0..t_len {
+                    self.marginals_into(&q.memberships, &mut sc);
+                    let (post, phi) = (&sc.post, &sc.phi);
+                    // Expected score under the HMM posteriors.
+                    let mut e_score = 0.0;
                     for j in 0..s {
-                        e_score += q.gamma[t][j] * phi[t][j];
+                        e_score += q.gamma[j] * self.init[j];
+                        g[j] += q.gamma[j] - post.gamma[j];
                     }
-                }
-                let obj = e_score - post.log_likelihood;
-                // Gradient: HMM-expected minus CRF-expected features.
-                for j in 0..s {
-                    g[j] += q.gamma[0][j] - post.gamma[0][j];
-                }
-                for (xh, xc) in q.xi.iter().zip(&post.xi) {
                     for idx in 0..s * s {
-                        g[s + idx] += xh[idx] - xc[idx];
+                        e_score += q.xi_sum[idx] * self.trans[idx];
+                        g[s + idx] += q.xi_sum[idx] - post.xi_sum[idx];
                     }
-                }
-                let off = s + s * s;
-                for t in 0..t_len {
-                    for j in 0..s {
-                        let d = q.gamma[t][j] - post.gamma[t][j];
-                        if d == 0.0 {
-                            continue;
-                        }
-                        for w in 0..w_len.min(t + 1) {
-                            let mt = &q.memberships[t - w];
-                            let base = off + (j * w_len + w) * k;
-                            for kk in 0..k {
-                                g[base + kk] += d * mt[kk];
+                    for t in 0..t_len {
+                        for j in 0..s {
+                            let gh = q.gamma[t * s + j];
+                            e_score += gh * phi[t * s + j];
+                            let d = gh - post.gamma[t * s + j];
+                            if d == 0.0 {
+                                continue;
+                            }
+                            for w in 0..w_len.min(t + 1) {
+                                let mt = &q.memberships[t - w];
+                                let base = off + (j * w_len + w) * k;
+                                for (gv, mv) in g[base..base + k].iter_mut().zip(mt) {
+                                    *gv += d * mv;
+                                }
                             }
                         }
                     }
+                    obj += e_score - post.log_likelihood;
+                    ((obj, g), sc)
+                },
+            )
+            .map(|(acc, _)| acc)
+            .reduce(zero, |(oa, mut ga), (ob, gb)| {
+                for (a, b) in ga.iter_mut().zip(&gb) {
+                    *a += b;
                 }
-                (obj, g)
+                (oa + ob, ga)
             })
-            .collect();
-        let theta = self.to_vec();
-        let mut obj = -0.5 * l2 * theta.iter().map(|v| v * v).sum::<f64>();
-        let mut grad: Vec<f64> = theta.iter().map(|v| -l2 * v).collect();
-        for (o, g) in per_seq {
-            obj += o;
-            for (a, b) in grad.iter_mut().zip(g) {
-                *a += b;
+    }
+
+    /// Objective (to maximize) and its gradient over the training sequences, with the L2
+    /// penalty of strength `l2` toward `center` (lagged observation weights times
+    /// `lag_penalty`; see the module docs). `center = None` penalizes toward zero.
+    pub fn objective_and_gradient(
+        &self,
+        seqs: &[TrainSeq],
+        l2: f64,
+        lag_penalty: f64,
+        center: Option<&Crf>,
+    ) -> (f64, Vec<f64>) {
+        let (mut obj, mut grad) = self.data_term(seqs);
+        if l2 > 0.0 {
+            let theta = self.to_vec();
+            let c0 = center.map(Crf::to_vec);
+            let scale = self.penalty_scale(lag_penalty);
+            for p in 0..theta.len() {
+                let d = theta[p] - c0.as_ref().map_or(0.0, |c| c[p]);
+                obj -= 0.5 * l2 * scale[p] * d * d;
+                grad[p] -= l2 * scale[p] * d;
             }
         }
         (obj, grad)
     }
 
-    /// Trains on `seqs` (all with `states` posteriors and `clusters` memberships).
+    /// Expected log-likelihood of held-out HMM posteriors (no penalty).
+    pub fn expected_log_likelihood(&self, seqs: &[TrainSeq]) -> f64 {
+        self.data_term(seqs).0
+    }
+
+    /// Trains on `seqs` (all with `states` posteriors and `clusters` memberships), penalized
+    /// toward `center` (see the module docs) and starting from `start` (a warm start; the
+    /// center when `None`).
     pub fn fit(
         seqs: &[TrainSeq],
-        states: usize,
-        clusters: usize,
+        center: &Crf,
+        start: Option<&Crf>,
         cfg: &CrfConfig,
     ) -> Result<(Crf, CrfReport), String> {
-        let start = Crf::zeros(states, clusters, cfg.window.max(1));
+        let start = start.unwrap_or(center).clone();
         let steps: usize = seqs
             .iter()
             .map(|q| q.memberships.len())
@@ -274,7 +402,10 @@ impl Crf {
             template: start.clone(),
             seqs,
             l2: cfg.l2,
+            lag_penalty: cfg.lag_penalty,
+            center,
             scale: 1.0 / steps as f64,
+            cache: Mutex::new(None),
         };
         let linesearch = MoreThuenteLineSearch::new();
         let solver = LBFGS::new(linesearch, 10)
@@ -292,7 +423,7 @@ impl Crf {
             .cloned()
             .unwrap_or_else(|| start.to_vec());
         let crf = start.with_params(&best);
-        let objective = crf.objective_and_gradient(seqs, cfg.l2).0;
+        let objective = -state.get_best_cost() * steps as f64;
         Ok((
             crf,
             CrfReport {
@@ -304,20 +435,44 @@ impl Crf {
     }
 }
 
-/// argmin's view: minimize the negative objective per step (scaled for conditioning).
+/// Parameters, cost and gradient of the last evaluation.
+type Evaluated = (Vec<f64>, f64, Vec<f64>);
+
+/// argmin's view: minimize the negative objective per step (scaled for conditioning). Cost
+/// and gradient are computed together and cached for the parameters last seen.
 struct Problem<'a> {
     template: Crf,
     seqs: &'a [TrainSeq],
     l2: f64,
+    lag_penalty: f64,
+    center: &'a Crf,
     scale: f64,
+    cache: Mutex<Option<Evaluated>>,
+}
+
+impl Problem<'_> {
+    fn eval(&self, p: &[f64]) -> (f64, Vec<f64>) {
+        let mut cache = self.cache.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((q, c, g)) = cache.as_ref() {
+            if q.as_slice() == p {
+                return (*c, g.clone());
+            }
+        }
+        let crf = self.template.with_params(p);
+        let (obj, grad) =
+            crf.objective_and_gradient(self.seqs, self.l2, self.lag_penalty, Some(self.center));
+        let c = -obj * self.scale;
+        let g: Vec<f64> = grad.iter().map(|v| -v * self.scale).collect();
+        *cache = Some((p.to_vec(), c, g.clone()));
+        (c, g)
+    }
 }
 
 impl CostFunction for Problem<'_> {
     type Param = Vec<f64>;
     type Output = f64;
     fn cost(&self, p: &Vec<f64>) -> Result<f64, argmin::core::Error> {
-        let crf = self.template.with_params(p);
-        Ok(-crf.objective_and_gradient(self.seqs, self.l2).0 * self.scale)
+        Ok(self.eval(p).0)
     }
 }
 
@@ -325,9 +480,7 @@ impl Gradient for Problem<'_> {
     type Param = Vec<f64>;
     type Gradient = Vec<f64>;
     fn gradient(&self, p: &Vec<f64>) -> Result<Vec<f64>, argmin::core::Error> {
-        let crf = self.template.with_params(p);
-        let g = crf.objective_and_gradient(self.seqs, self.l2).1;
-        Ok(g.iter().map(|v| -v * self.scale).collect())
+        Ok(self.eval(p).1)
     }
 }
 
@@ -359,10 +512,16 @@ mod tests {
                 .map(|j| (0..s).map(|i| last[i * s + j]).sum())
                 .collect(),
         );
+        let mut xi_sum = vec![0.0; s * s];
+        for x in &xi {
+            for (a, b) in xi_sum.iter_mut().zip(x) {
+                *a += b;
+            }
+        }
         TrainSeq {
             memberships,
-            gamma,
-            xi,
+            gamma: gamma.concat(),
+            xi_sum,
         }
     }
 
@@ -377,21 +536,52 @@ mod tests {
             *v = rng.random_range(-1.0..1.0);
         }
         crf = crf.with_params(&theta);
-        let (_, grad) = crf.objective_and_gradient(&seqs, 0.1);
+        let center = Crf::prior(&[0.5, 0.3, 0.2], k, w);
+        let obj = |c: &Crf| c.objective_and_gradient(&seqs, 0.1, 7.0, Some(&center));
+        let (_, grad) = obj(&crf);
         let h = 1e-6;
         for i in 0..theta.len() {
             let mut a = theta.clone();
             a[i] += h;
             let mut b = theta.clone();
             b[i] -= h;
-            let fa = crf.with_params(&a).objective_and_gradient(&seqs, 0.1).0;
-            let fb = crf.with_params(&b).objective_and_gradient(&seqs, 0.1).0;
+            let fa = obj(&crf.with_params(&a)).0;
+            let fb = obj(&crf.with_params(&b)).0;
             let fd = (fa - fb) / (2.0 * h);
             assert!(
                 (fd - grad[i]).abs() < 1e-6 * (1.0 + fd.abs()),
                 "param {i}: fd {fd} vs {}",
                 grad[i]
             );
+        }
+    }
+
+    #[test]
+    fn the_prior_crf_believes_the_prior_and_heavy_l2_stays_there() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let (s, k, w) = (3, 4, 3);
+        let prior = [0.6, 0.3, 0.1];
+        let center = Crf::prior(&prior, k, w);
+        let q = random_seq(&mut rng, 30, s, k);
+        for b in center.beliefs(&q.memberships) {
+            for (x, p) in b.iter().zip(&prior) {
+                assert!((x - p).abs() < 1e-12, "{b:?}");
+            }
+        }
+        // An overwhelming penalty toward the prior CRF leaves the belief at the prior (a
+        // penalty toward zero would leave it uniform).
+        let seqs = vec![random_seq(&mut rng, 40, s, k)];
+        let cfg = CrfConfig {
+            window: w,
+            l2: 1e9,
+            lag_penalty: 10.0,
+            ..CrfConfig::default()
+        };
+        let (crf, _) = Crf::fit(&seqs, &center, None, &cfg).unwrap();
+        for b in crf.beliefs(&q.memberships) {
+            for (x, p) in b.iter().zip(&prior) {
+                assert!((x - p).abs() < 1e-6, "{b:?}");
+            }
         }
     }
 
@@ -426,6 +616,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let (s, k) = (3, 3);
         let mut seqs = Vec::new();
+        let mut truth = Vec::new();
         for _ in 0..6 {
             let t_len = 80;
             let mut state = 0usize;
@@ -446,25 +637,24 @@ mod tests {
                 g[state] = 1.0;
                 gamma.push(g);
             }
-            let xi = (0..t_len - 1)
-                .map(|t| {
-                    let mut x = vec![0.0; s * s];
-                    let i = gamma[t].iter().position(|&v| v == 1.0).unwrap();
-                    let j = gamma[t + 1].iter().position(|&v| v == 1.0).unwrap();
-                    x[i * s + j] = 1.0;
-                    x
-                })
-                .collect();
+            let mut xi_sum = vec![0.0; s * s];
+            for t in 0..t_len - 1 {
+                let i = gamma[t].iter().position(|&v| v == 1.0).unwrap();
+                let j = gamma[t + 1].iter().position(|&v| v == 1.0).unwrap();
+                xi_sum[i * s + j] += 1.0;
+            }
+            truth.push(gamma.clone());
             seqs.push(TrainSeq {
                 memberships,
-                gamma,
-                xi,
+                gamma: gamma.concat(),
+                xi_sum,
             });
         }
+        let center = Crf::prior(&[1.0 / 3.0; 3], k, 2);
         let (crf, report) = Crf::fit(
             &seqs,
-            s,
-            k,
+            &center,
+            None,
             &CrfConfig {
                 window: 2,
                 ..CrfConfig::default()
@@ -474,8 +664,8 @@ mod tests {
         assert!(report.iterations > 0);
         let mut right = 0;
         let mut total = 0;
-        for q in &seqs {
-            for (b, g) in crf.beliefs(&q.memberships).iter().zip(&q.gamma) {
+        for (q, tr) in seqs.iter().zip(&truth) {
+            for (b, g) in crf.beliefs(&q.memberships).iter().zip(tr) {
                 let best = (0..s)
                     .max_by(|&a, &c| b[a].partial_cmp(&b[c]).unwrap())
                     .unwrap();

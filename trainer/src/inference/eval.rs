@@ -1,5 +1,8 @@
-//! The paper's Fig. 4 comparison (DESIGN.md, inference layer step 5): how well each method's
-//! *online* belief over states explains held-out kinematics.
+//! The paper's Fig. 4 comparison (docs/method.md, "Inference layer", step 5): how well each
+//! method's *online* belief over states explains held-out kinematics. [`evaluate`] is the
+//! whole of `gesture-train eval-inference`: fit on a training corpus (choosing what is left
+//! open, see [`super::select`]), score each window on a test corpus, report the CRF's gain
+//! over the prior.
 //!
 //! Score of a test step: `log sum_i b_t(i) N(y_t; mu_i, Sigma_i)`, `y_t` the step's normalized
 //! kinematic target and `N(.; mu_i, Sigma_i)` the kinematic HMM's state Gaussians; reported as
@@ -15,12 +18,162 @@
 //! Also the adjusted Rand index between two labelings (hand-written: a dozen lines of
 //! contingency counting, not worth a dependency).
 
-use gesture_runtime::inference::StepFeatures;
+use std::collections::HashMap;
+use std::time::Instant;
+
+use gesture_runtime::inference::{StepFeatures, MAX_WINDOW};
+use serde::Serialize;
 
 use super::crf::Crf;
 use super::gaussian::{log_sum_exp, Gaussian};
 use super::hmm::Seq;
-use super::train::{memberships, FitBase, Sequence};
+use super::select::{self, Selection};
+use super::train::{
+    fit_base, fit_crf, memberships, normalized, FitBase, FitConfig, FitError, FitReport, Sequence,
+};
+
+/// One row of the comparison (mean log-likelihood per test step).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Row {
+    /// Window W.
+    pub window: usize,
+    /// CRF.
+    pub crf: f64,
+    /// Brand's remapped HMM.
+    pub hmm: f64,
+    /// State prior.
+    pub prior: f64,
+    /// `crf - prior`: what the CRF's belief knows beyond the prior (nats per step).
+    pub gain: f64,
+    /// CRF L2 strength per training step used for this window.
+    pub l2: f64,
+    /// CRF lag penalty used for this window.
+    pub lag_penalty: f64,
+}
+
+/// Planted state runs `(start_s, end_s, state)` per take stem (a synthetic corpus's truth).
+pub type PlantedRuns = HashMap<String, Vec<(f64, f64, usize)>>;
+
+/// What [`evaluate`] measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct EvalReport {
+    /// One row per window.
+    pub rows: Vec<Row>,
+    /// States S used.
+    pub states: usize,
+    /// Clusters K used.
+    pub clusters: usize,
+    /// Training steps.
+    pub train_steps: usize,
+    /// Test steps.
+    pub test_steps: usize,
+    /// Adjusted Rand index of the HMM's states against planted ones on the training and test
+    /// data, when known.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ari: Option<(f64, Option<f64>)>,
+    /// Model selection curves.
+    #[serde(skip)]
+    pub selection: Option<Selection>,
+    /// Wall time (s).
+    #[serde(skip)]
+    pub seconds: f64,
+}
+
+/// Fits on `train` (S and K chosen once with window `cfg.window` when open), then for each of
+/// `windows` fits the CRF (regularization chosen per window when open) and Brand's remapped
+/// HMM, and scores their online beliefs and the prior on `test`.
+pub fn evaluate(
+    train: (&[Sequence], &[[f64; 6]]),
+    test: &[Sequence],
+    cfg: &FitConfig,
+    windows: &[usize],
+    planted: (Option<&PlantedRuns>, Option<&PlantedRuns>),
+    log: &(dyn Fn(&str) + Sync),
+) -> Result<EvalReport, FitError> {
+    let start = Instant::now();
+    let (train_seqs, segs) = train;
+    let test_steps: usize = test.iter().map(Sequence::len).sum();
+    if test_steps == 0 {
+        return Err(FitError::Settings(
+            "the test set has no time steps (check --test and --test-span)".into(),
+        ));
+    }
+    if let Some(w) = windows.iter().find(|w| !(1..=MAX_WINDOW).contains(w)) {
+        return Err(FitError::Settings(format!(
+            "window {w} out of range 1-{MAX_WINDOW}"
+        )));
+    }
+    let choice = select::choose(train_seqs, segs, cfg, windows, log)?;
+    let mut report = FitReport::default();
+    let base = fit_base(
+        train_seqs,
+        segs,
+        choice.states,
+        choice.clusters,
+        cfg,
+        &mut report,
+        log,
+    )?;
+    let y_test = normalized(test, &base.normalization);
+    let prior = mean_score(&base, &y_test, &prior_beliefs(&base, test));
+    let mut rows = Vec::new();
+    for (&w, &(l2, lag)) in windows.iter().zip(&choice.regularization) {
+        let crf = fit_crf(&base, w, l2, lag, &mut report, log)?;
+        let crf_score = mean_score(&base, &y_test, &crf_beliefs(&base, &crf, test));
+        let brand = RemappedHmm::fit(&base, train_seqs, w);
+        let hb: Vec<Vec<Vec<f64>>> = test.iter().map(|s| brand.beliefs(&base, s)).collect();
+        rows.push(Row {
+            window: w,
+            crf: crf_score,
+            hmm: mean_score(&base, &y_test, &hb),
+            prior,
+            gain: crf_score - prior,
+            l2,
+            lag_penalty: lag,
+        });
+    }
+    let ari = planted.0.and_then(|runs| {
+        let train_ari = planted_ari(&base, train_seqs, &base.y, runs)?;
+        let test_ari = planted.1.and_then(|r| planted_ari(&base, test, &y_test, r));
+        Some((train_ari, test_ari))
+    });
+    Ok(EvalReport {
+        rows,
+        states: choice.states,
+        clusters: choice.clusters,
+        train_steps: report.steps,
+        test_steps,
+        ari,
+        selection: choice.selection,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// ARI between the HMM's states (argmax posterior) and the planted states at step midpoints.
+pub fn planted_ari(
+    base: &FitBase,
+    seqs: &[Sequence],
+    y: &[Seq],
+    runs: &PlantedRuns,
+) -> Option<f64> {
+    let (mut found, mut planted) = (Vec::new(), Vec::new());
+    for (s, ys) in seqs.iter().zip(y) {
+        let r = runs.get(&s.stem)?;
+        let post = base.hmm.posterior(ys);
+        for (g, &(a, b)) in post.gamma_rows().zip(&s.times) {
+            let mid = 0.5 * (a + b);
+            let Some(&(_, _, state)) = r.iter().find(|(s0, s1, _)| mid >= *s0 && mid < *s1) else {
+                continue;
+            };
+            let best = (0..g.len())
+                .max_by(|&i, &j| g[i].total_cmp(&g[j]))
+                .unwrap_or(0);
+            found.push(best);
+            planted.push(state);
+        }
+    }
+    (!found.is_empty()).then(|| adjusted_rand_index(&found, &planted))
+}
 
 /// Mean per-step score of `y` (normalized) under beliefs `b` and the HMM state Gaussians.
 pub fn mean_score(base: &FitBase, y: &[Seq], beliefs: &[Vec<Vec<f64>>]) -> f64 {
@@ -99,12 +252,13 @@ impl RemappedHmm {
             / dims as f64;
         let eps = (1e-3 * var).max(1e-6);
         let mean0 = vec![0.0; dims];
+        let k = base.hmm.states();
         let emit = (0..base.hmm.states())
             .map(|i| {
                 let w: Vec<f64> = base
                     .train
                     .iter()
-                    .flat_map(|q| q.gamma.iter().map(move |g| g[i]))
+                    .flat_map(|q| q.gamma.chunks_exact(k).map(move |g| g[i]))
                     .collect();
                 Gaussian::fit_weighted(&xs, &w, eps, &mean0)
             })

@@ -7,9 +7,48 @@
 //! is therefore positive definite, even for a state that owns one point, and [`log_prior`]
 //! gives the term EM adds to its objective.
 //!
+//! More generally ([`CovPrior`]), the prior is an inverse Wishart with scale matrix `Psi` and
+//! `nu` degrees of freedom (counted as pseudo-observations): `Sigma = (S + Psi) / (n + nu)`,
+//! log prior `-(nu/2) log|Sigma| - tr(Psi Sigma^-1)/2`. The plain floor is `Psi = eps I`,
+//! `nu = 1`; [`CovPrior::shrink_to`] adds `tau` pseudo-observations spread like a reference
+//! covariance, which pulls a state's covariance toward it (docs/method.md, "Inference layer").
+//!
 //! [`log_prior`]: Gaussian::log_prior
 
 use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
+
+/// An inverse-Wishart prior on a covariance (see the module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CovPrior {
+    /// Scale matrix `Psi` (a scatter: pseudo-observations times a covariance).
+    pub psi: DMatrix<f64>,
+    /// Pseudo-observations `nu`.
+    pub nu: f64,
+}
+
+impl CovPrior {
+    /// The plain floor `Psi = eps I`, `nu = 1`.
+    pub fn floor(dims: usize, eps: f64) -> Self {
+        Self {
+            psi: DMatrix::identity(dims, dims) * eps,
+            nu: 1.0,
+        }
+    }
+
+    /// The floor plus `tau` pseudo-observations with covariance
+    /// `(1 - iso) reference + iso (tr(reference) / d) I`: a state that owns few distinct
+    /// vectors keeps a covariance close to the reference instead of collapsing onto them, and
+    /// the isotropic part keeps directions where the reference itself is nearly singular open.
+    pub fn shrink_to(reference: &DMatrix<f64>, tau: f64, iso: f64, eps: f64) -> Self {
+        let d = reference.nrows();
+        let mean_var = reference.trace() / d.max(1) as f64;
+        let target = reference * (1.0 - iso) + DMatrix::identity(d, d) * (iso * mean_var);
+        Self {
+            psi: target * tau + DMatrix::identity(d, d) * eps,
+            nu: tau + 1.0,
+        }
+    }
+}
 
 /// A Gaussian `N(mean, cov)` with its Cholesky factor cached.
 #[derive(Clone, Debug)]
@@ -60,24 +99,43 @@ impl Gaussian {
         &self.cov
     }
 
-    /// `log N(x; mean, cov)`.
+    /// `log N(x; mean, cov)`. Allocation-free for dimensions up to 32 (forward substitution
+    /// into a stack buffer).
     pub fn log_pdf(&self, x: &[f64]) -> f64 {
-        let d = DVector::from_iterator(
-            self.dim(),
-            x.iter().zip(self.mean.iter()).map(|(a, m)| a - m),
-        );
-        let z = self
-            .chol
-            .l_dirty()
-            .solve_lower_triangular(&d)
-            .unwrap_or_else(|| DVector::from_element(self.dim(), f64::INFINITY));
-        self.log_norm - 0.5 * z.norm_squared()
+        let d = self.dim();
+        let l = self.chol.l_dirty();
+        let mut stack = [0.0f64; 32];
+        let mut heap;
+        let z: &mut [f64] = if d <= 32 {
+            &mut stack[..d]
+        } else {
+            heap = vec![0.0; d];
+            &mut heap
+        };
+        let mut q = 0.0;
+        for i in 0..d {
+            let mut v = x[i] - self.mean[i];
+            for j in 0..i {
+                v -= l[(i, j)] * z[j];
+            }
+            z[i] = v / l[(i, i)];
+            q += z[i] * z[i];
+        }
+        self.log_norm - 0.5 * q
     }
 
     /// MAP fit from rows `xs` with weights `w` (covariance floor `eps`, see the module docs).
     /// With zero total weight, the result is `N(fallback_mean, eps I)`.
     pub fn fit_weighted(xs: &[Vec<f64>], w: &[f64], eps: f64, fallback_mean: &[f64]) -> Self {
+        let prior = CovPrior::floor(fallback_mean.len(), eps);
+        Self::fit_map(xs, w, &prior, fallback_mean)
+    }
+
+    /// MAP fit from rows `xs` with weights `w` under `prior`: `Sigma = (S + Psi) / (n + nu)`.
+    /// With zero total weight, the result is `N(fallback_mean, Psi / nu)`.
+    pub fn fit_map(xs: &[Vec<f64>], w: &[f64], prior: &CovPrior, fallback_mean: &[f64]) -> Self {
         let d = fallback_mean.len();
+        let eps = prior.psi.trace() / (d.max(1) as f64 * prior.nu.max(1e-12));
         let n: f64 = w.iter().sum();
         let mut mean = DVector::<f64>::zeros(d);
         if n > 0.0 {
@@ -90,7 +148,7 @@ impl Gaussian {
         } else {
             mean.copy_from_slice(fallback_mean);
         }
-        let mut scatter = DMatrix::<f64>::identity(d, d) * eps;
+        let mut scatter = prior.psi.clone();
         for (x, &wi) in xs.iter().zip(w) {
             if wi == 0.0 {
                 continue;
@@ -107,7 +165,7 @@ impl Gaussian {
                 scatter[(a, b)] = scatter[(b, a)];
             }
         }
-        let cov = scatter / (n + 1.0);
+        let cov = scatter / (n + prior.nu);
         // Positive definite by construction (eps I plus a scatter); the fallback covers eps = 0.
         Self::new(mean.clone(), cov).unwrap_or_else(|| {
             Self::new(mean, DMatrix::identity(d, d) * eps.max(1e-9))
@@ -117,12 +175,20 @@ impl Gaussian {
 
     /// The log prior term of the covariance floor: `-(log|Sigma| + tr(eps Sigma^-1)) / 2`.
     pub fn log_prior(&self, eps: f64) -> f64 {
+        self.log_prior_under(&CovPrior::floor(self.dim(), eps))
+    }
+
+    /// The log prior term of `prior`: `-(nu log|Sigma| + tr(Psi Sigma^-1)) / 2`.
+    pub fn log_prior_under(&self, prior: &CovPrior) -> f64 {
         let d = self.dim();
         let inv = self.chol.inverse();
-        let tr: f64 = (0..d).map(|i| inv[(i, i)]).sum();
+        let tr: f64 = (0..d)
+            .flat_map(|i| (0..d).map(move |j| (i, j)))
+            .map(|(i, j)| prior.psi[(i, j)] * inv[(j, i)])
+            .sum();
         // log|Sigma| = -2 (log_norm + d/2 log 2pi)
         let log_det = -2.0 * (self.log_norm + 0.5 * d as f64 * (2.0 * std::f64::consts::PI).ln());
-        -0.5 * (log_det + eps * tr)
+        -0.5 * (prior.nu * log_det + tr)
     }
 }
 

@@ -1,5 +1,5 @@
-//! Gaussian mixture over per-step prosody, with unvoiced F0 marginalized out (DESIGN.md,
-//! inference layer step 2).
+//! Gaussian mixture over per-step prosody, with unvoiced F0 marginalized out (docs/method.md,
+//! "Inference layer", step 2).
 //!
 //! A step's prosody is `x = (f0, o)`: `f0` the (normalized) log pitch, missing when the step is
 //! unvoiced, and `o = (intensity, log length)`, always present. Component `k` is

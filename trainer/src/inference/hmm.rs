@@ -1,9 +1,19 @@
 //! Hidden Markov model with full-covariance Gaussian emissions over the kinematic parameters,
-//! trained by EM (Baum-Welch) with seeded restarts (DESIGN.md, inference layer step 1).
+//! trained by EM (Baum-Welch) with seeded restarts (docs/method.md, "Inference layer", step 1).
 //!
 //! - Forward-backward is *scaled* (per-step normalization, emissions shifted by their per-step
-//!   maximum in log space), so sequences of any length neither underflow nor overflow.
-//! - The covariance floor and a small Dirichlet pseudo-count on the initial and transition
+//!   maximum in log space), so sequences of any length neither underflow nor overflow; and
+//!   *flat* (`[t * S + i]` buffers reused between calls through [`FbWork`], so EM's E-step
+//!   allocates nothing once warmed up); it returns the expected transition counts, not
+//!   per-step pairwise posteriors.
+//! - **Covariance shrinkage** ([`HmmConfig::shrinkage`], [`CovPrior::shrink_to`]): every step
+//!   inside a motion segment carries that segment's kinematic vector, so a state sees few
+//!   distinct vectors and a maximum-likelihood covariance collapses onto them; and
+//!   `ln D - ln V - ln T` is nearly constant (path = speed x duration), so one direction of
+//!   the data is nearly singular. Each state's covariance is therefore the MAP estimate under
+//!   an inverse-Wishart prior worth 10 steps of the corpus covariance (3% of it isotropic).
+//!   Held-out likelihood, not training likelihood, is what this buys.
+//! - The covariance prior and a small Dirichlet pseudo-count on the initial and transition
 //!   probabilities are priors, so EM is a MAP-EM: the reported objective (log-likelihood plus
 //!   log-prior) never decreases from one iteration to the next (tested).
 //! - Initialization: k-means++ seeding and a few Lloyd iterations from a seeded RNG, on the
@@ -19,7 +29,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::gaussian::Gaussian;
+use super::gaussian::{CovPrior, Gaussian};
+use nalgebra::DMatrix;
 
 /// A sequence of observation vectors (steps x dims).
 pub type Seq = Vec<Vec<f64>>;
@@ -47,6 +58,11 @@ pub struct HmmConfig {
     /// (the "sticky" HMM prior of Fox et al. 2011): hidden states that should be slow (styles)
     /// are not spent on fast alternations (gesture phases). 0 = off.
     pub stickiness: f64,
+    /// Pseudo-steps of the corpus covariance added to every state's covariance (see the
+    /// module docs, "Covariance shrinkage"). 0 = the floor alone.
+    pub shrinkage: f64,
+    /// Isotropic share of the shrinkage target.
+    pub isotropic: f64,
 }
 
 impl Default for HmmConfig {
@@ -61,6 +77,8 @@ impl Default for HmmConfig {
             seed: 1,
             init_smoothing: 4,
             stickiness: 0.0,
+            shrinkage: 10.0,
+            isotropic: 0.03,
         }
     }
 }
@@ -91,15 +109,45 @@ pub enum HmmError {
     NoStates,
 }
 
-/// Posteriors of one sequence.
-#[derive(Clone, Debug)]
+/// Posteriors of one sequence, flat: `gamma[t * S + i] = P(q_t = i | y)`.
+#[derive(Clone, Debug, Default)]
 pub struct Posterior {
-    /// `gamma[t][i] = P(q_t = i | y)`.
-    pub gamma: Vec<Vec<f64>>,
-    /// `xi[t][i * S + j] = P(q_t = i, q_{t+1} = j | y)`, for `t < T - 1`.
-    pub xi: Vec<Vec<f64>>,
+    /// States S.
+    pub states: usize,
+    /// `gamma[t * S + i] = P(q_t = i | y)` (T x S, row-major).
+    pub gamma: Vec<f64>,
+    /// `xi_sum[i * S + j] = sum_t P(q_t = i, q_{t+1} = j | y)`: the expected transition
+    /// counts (all that EM and the CRF gradient need of the pairwise posteriors).
+    pub xi_sum: Vec<f64>,
     /// `log p(y)`.
     pub log_likelihood: f64,
+}
+
+impl Posterior {
+    /// Steps T.
+    pub fn steps(&self) -> usize {
+        self.gamma.len() / self.states.max(1)
+    }
+
+    /// `P(q_t = . | y)`.
+    pub fn gamma_at(&self, t: usize) -> &[f64] {
+        &self.gamma[t * self.states..(t + 1) * self.states]
+    }
+
+    /// The rows of `gamma`, one per step.
+    pub fn gamma_rows(&self) -> std::slice::ChunksExact<'_, f64> {
+        self.gamma.chunks_exact(self.states.max(1))
+    }
+}
+
+/// Scratch buffers of [`forward_backward_into`], reused between calls so the E-step and the
+/// CRF gradient allocate nothing once warmed up.
+#[derive(Clone, Debug, Default)]
+pub struct FbWork {
+    b: Vec<f64>,
+    alpha: Vec<f64>,
+    beta: Vec<f64>,
+    scale: Vec<f64>,
 }
 
 /// A fitted HMM.
@@ -113,6 +161,8 @@ pub struct Hmm {
     pub emit: Vec<Gaussian>,
     /// Covariance floor used (absolute).
     pub eps: f64,
+    /// The covariance prior EM used (the floor alone for a model read from a file).
+    pub cov_prior: CovPrior,
 }
 
 /// What one EM run did.
@@ -126,88 +176,128 @@ pub struct RunReport {
     pub log_likelihood: f64,
 }
 
-/// Scaled forward-backward for a generic chain: `init`, row-major `trans` (S x S) and log
-/// emission scores `log_b[t][i]`.
-pub fn forward_backward(init: &[f64], trans: &[f64], log_b: &[Vec<f64>]) -> Posterior {
+/// Scaled forward-backward for a generic chain: `init`, row-major `trans` (S x S) and flat log
+/// emission scores `log_b[t * S + i]`.
+pub fn forward_backward(init: &[f64], trans: &[f64], log_b: &[f64]) -> Posterior {
+    let mut post = Posterior::default();
+    forward_backward_into(init, trans, log_b, &mut FbWork::default(), &mut post);
+    post
+}
+
+/// [`forward_backward`] into reused buffers: allocates only when a sequence is longer than
+/// any seen before by `work` and `out`. Flat loops over `t * S + i`.
+pub fn forward_backward_into(
+    init: &[f64],
+    trans: &[f64],
+    log_b: &[f64],
+    work: &mut FbWork,
+    out: &mut Posterior,
+) {
     let s = init.len();
-    let t_len = log_b.len();
+    let t_len = log_b.len().checked_div(s).unwrap_or(0);
+    out.states = s;
+    out.gamma.clear();
+    out.gamma.resize(t_len * s, 0.0);
+    out.xi_sum.clear();
+    out.xi_sum.resize(s * s, 0.0);
+    out.log_likelihood = 0.0;
     if t_len == 0 {
-        return Posterior {
-            gamma: vec![],
-            xi: vec![],
-            log_likelihood: 0.0,
-        };
+        return;
     }
-    let mut b = vec![vec![0.0; s]; t_len];
-    let mut offset = vec![0.0; t_len];
+    let FbWork {
+        b,
+        alpha,
+        beta,
+        scale,
+    } = work;
+    b.clear();
+    b.resize(t_len * s, 0.0);
+    alpha.clear();
+    alpha.resize(t_len * s, 0.0);
+    beta.clear();
+    beta.resize(t_len * s, 1.0);
+    scale.clear();
+    scale.resize(t_len, 0.0);
+    let mut offset_sum = 0.0;
     for t in 0..t_len {
-        let m = log_b[t].iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let row = &log_b[t * s..(t + 1) * s];
+        let m = row.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
         let m = if m.is_finite() { m } else { 0.0 };
-        offset[t] = m;
-        for i in 0..s {
-            b[t][i] = (log_b[t][i] - m).exp();
+        offset_sum += m;
+        for (bi, &l) in b[t * s..(t + 1) * s].iter_mut().zip(row) {
+            *bi = (l - m).exp();
         }
     }
-    let mut alpha = vec![vec![0.0; s]; t_len];
-    let mut scale = vec![0.0; t_len];
     for i in 0..s {
-        alpha[0][i] = init[i] * b[0][i];
+        alpha[i] = init[i] * b[i];
     }
-    scale[0] = alpha[0].iter().sum::<f64>().max(f64::MIN_POSITIVE);
-    alpha[0].iter_mut().for_each(|a| *a /= scale[0]);
-    for t in 1..t_len {
-        for j in 0..s {
-            let mut acc = 0.0;
-            for i in 0..s {
-                acc += alpha[t - 1][i] * trans[i * s + j];
-            }
-            alpha[t][j] = acc * b[t][j];
-        }
-        scale[t] = alpha[t].iter().sum::<f64>().max(f64::MIN_POSITIVE);
-        let c = scale[t];
-        alpha[t].iter_mut().for_each(|a| *a /= c);
-    }
-    let mut beta = vec![vec![1.0; s]; t_len];
-    for t in (0..t_len - 1).rev() {
-        for i in 0..s {
-            let mut acc = 0.0;
-            for j in 0..s {
-                acc += trans[i * s + j] * b[t + 1][j] * beta[t + 1][j];
-            }
-            beta[t][i] = acc / scale[t + 1];
-        }
-    }
-    let mut gamma = vec![vec![0.0; s]; t_len];
     for t in 0..t_len {
-        let mut z = 0.0;
-        for i in 0..s {
-            gamma[t][i] = alpha[t][i] * beta[t][i];
-            z += gamma[t][i];
-        }
-        if z > 0.0 {
-            gamma[t].iter_mut().for_each(|g| *g /= z);
-        }
-    }
-    let mut xi = vec![vec![0.0; s * s]; t_len.saturating_sub(1)];
-    for t in 0..t_len.saturating_sub(1) {
-        let mut z = 0.0;
-        for i in 0..s {
+        if t > 0 {
+            let (prev, cur) = alpha.split_at_mut(t * s);
+            let prev = &prev[(t - 1) * s..];
+            let cur = &mut cur[..s];
+            cur.fill(0.0);
+            for i in 0..s {
+                let a = prev[i];
+                if a == 0.0 {
+                    continue;
+                }
+                let row = &trans[i * s..(i + 1) * s];
+                for j in 0..s {
+                    cur[j] += a * row[j];
+                }
+            }
             for j in 0..s {
-                let v = alpha[t][i] * trans[i * s + j] * b[t + 1][j] * beta[t + 1][j];
-                xi[t][i * s + j] = v;
-                z += v;
+                cur[j] *= b[t * s + j];
             }
         }
-        if z > 0.0 {
-            xi[t].iter_mut().for_each(|v| *v /= z);
+        let row = &mut alpha[t * s..(t + 1) * s];
+        let c = row.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+        scale[t] = c;
+        row.iter_mut().for_each(|a| *a /= c);
+    }
+    // beta[t] = sum_j trans[i, j] b[t+1, j] beta[t+1, j] / scale[t+1]; `tmp` (the product
+    // b * beta of step t + 1) lives in gamma's row t + 1 until gamma is written.
+    for t in (0..t_len - 1).rev() {
+        let c = scale[t + 1];
+        for j in 0..s {
+            out.gamma[(t + 1) * s + j] = b[(t + 1) * s + j] * beta[(t + 1) * s + j];
+        }
+        let tmp = &out.gamma[(t + 1) * s..(t + 2) * s];
+        for i in 0..s {
+            let row = &trans[i * s..(i + 1) * s];
+            let mut acc = 0.0;
+            for j in 0..s {
+                acc += row[j] * tmp[j];
+            }
+            beta[t * s + i] = acc / c;
+        }
+        // Pairwise posteriors of (t, t + 1): alpha[t, i] trans[i, j] tmp[j] / scale[t + 1]
+        // already sum to 1 with scaled alpha and beta.
+        for i in 0..s {
+            let a = alpha[t * s + i] / c;
+            if a == 0.0 {
+                continue;
+            }
+            let row = &trans[i * s..(i + 1) * s];
+            let xs = &mut out.xi_sum[i * s..(i + 1) * s];
+            for j in 0..s {
+                xs[j] += a * row[j] * tmp[j];
+            }
         }
     }
-    let log_likelihood = scale.iter().map(|c| c.ln()).sum::<f64>() + offset.iter().sum::<f64>();
-    Posterior {
-        gamma,
-        xi,
-        log_likelihood,
+    for t in 0..t_len {
+        let g = &mut out.gamma[t * s..(t + 1) * s];
+        let mut z = 0.0;
+        for i in 0..s {
+            g[i] = alpha[t * s + i] * beta[t * s + i];
+            z += g[i];
+        }
+        if z > 0.0 {
+            g.iter_mut().for_each(|v| *v /= z);
+        }
     }
+    out.log_likelihood = scale.iter().map(|c| c.ln()).sum::<f64>() + offset_sum;
 }
 
 impl Hmm {
@@ -216,11 +306,19 @@ impl Hmm {
         self.init.len()
     }
 
-    /// `log N(y_t; state i)` for every step and state.
-    pub fn log_emissions(&self, seq: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        seq.iter()
-            .map(|y| self.emit.iter().map(|g| g.log_pdf(y)).collect())
-            .collect()
+    /// `log N(y_t; state i)` for every step and state, flat (`[t * S + i]`).
+    pub fn log_emissions(&self, seq: &[Vec<f64>]) -> Vec<f64> {
+        let mut out = Vec::with_capacity(seq.len() * self.states());
+        self.log_emissions_into(seq, &mut out);
+        out
+    }
+
+    /// [`Hmm::log_emissions`] into a reused buffer.
+    pub fn log_emissions_into(&self, seq: &[Vec<f64>], out: &mut Vec<f64>) {
+        out.clear();
+        for y in seq {
+            out.extend(self.emit.iter().map(|g| g.log_pdf(y)));
+        }
     }
 
     /// Posteriors of a sequence.
@@ -233,7 +331,8 @@ impl Hmm {
         let mut f = vec![0.0; self.states()];
         let mut n = 0.0f64;
         for s in seqs {
-            for g in self.posterior(s).gamma {
+            let post = self.posterior(s);
+            for g in post.gamma_rows() {
                 for (a, b) in f.iter_mut().zip(g) {
                     *a += b;
                 }
@@ -262,7 +361,11 @@ impl Hmm {
                 c * p.max(1e-300).ln()
             })
             .sum();
-        let lp_g: f64 = self.emit.iter().map(|g| g.log_prior(self.eps)).sum();
+        let lp_g: f64 = self
+            .emit
+            .iter()
+            .map(|g| g.log_prior_under(&self.cov_prior))
+            .sum();
         lp_pi + lp_a + lp_g
     }
 
@@ -302,11 +405,27 @@ impl Hmm {
             var += all.iter().map(|v| (v[d] - m).powi(2)).sum::<f64>() / n;
         }
         let eps = (cfg.cov_floor * var / dims as f64).max(1e-9);
+        let mut cov = DMatrix::<f64>::zeros(dims, dims);
+        let mean: Vec<f64> = (0..dims)
+            .map(|d| all.iter().map(|v| v[d]).sum::<f64>() / n)
+            .collect();
+        for v in &all {
+            for a in 0..dims {
+                for b in 0..dims {
+                    cov[(a, b)] += (v[a] - mean[a]) * (v[b] - mean[b]) / n;
+                }
+            }
+        }
+        let prior = if cfg.shrinkage > 0.0 {
+            CovPrior::shrink_to(&cov, cfg.shrinkage, cfg.isotropic, eps)
+        } else {
+            CovPrior::floor(dims, eps)
+        };
         let runs: Vec<(Hmm, RunReport)> = (0..cfg.restarts.max(1))
             .into_par_iter()
             .map(|r| {
                 let seed = cfg.seed.wrapping_add(r as u64 * 0x9E37_79B9);
-                em_run(seqs, cfg, eps, seed, r, &progress)
+                em_run(seqs, cfg, eps, &prior, seed, r, &progress)
             })
             .collect();
         let mut best = 0;
@@ -405,6 +524,7 @@ fn em_run(
     seqs: &[Seq],
     cfg: &HmmConfig,
     eps: f64,
+    prior: &CovPrior,
     seed: u64,
     restart: usize,
     progress: &(impl Fn(usize, usize, f64) + Sync),
@@ -428,7 +548,7 @@ fn em_run(
                 .iter()
                 .map(|&a| if a == k { 1.0 } else { 0.0 })
                 .collect();
-            Gaussian::fit_weighted(&owned, &w, eps, &centre_mean)
+            Gaussian::fit_map(&owned, &w, prior, &centre_mean)
         })
         .collect();
     let mut trans = vec![0.0; s * s];
@@ -449,15 +569,42 @@ fn em_run(
         trans,
         emit,
         eps,
+        cov_prior: prior.clone(),
     };
     let mut objective = Vec::new();
     let mut last_ll = f64::NEG_INFINITY;
     let total_steps = owned.len() as f64;
     let sticky = cfg.stickiness * total_steps / s as f64;
+    let mut work = FbWork::default();
+    let mut log_b = Vec::new();
+    let mut post = Posterior::default();
+    let mut gamma_all = vec![0.0; owned.len() * s];
+    let mut w = vec![0.0; owned.len()];
     for it in 0..cfg.max_iter {
-        // E-step.
-        let posts: Vec<Posterior> = seqs.iter().map(|q| hmm.posterior(q)).collect();
-        let ll: f64 = posts.iter().map(|p| p.log_likelihood).sum();
+        // E-step, accumulating the expected counts.
+        let a = cfg.pseudo_count;
+        let mut init = vec![a; s];
+        let mut trans = vec![a; s * s];
+        for i in 0..s {
+            trans[i * s + i] += sticky;
+        }
+        let mut ll = 0.0;
+        let mut row0 = 0;
+        for q in seqs {
+            hmm.log_emissions_into(q, &mut log_b);
+            forward_backward_into(&hmm.init, &hmm.trans, &log_b, &mut work, &mut post);
+            ll += post.log_likelihood;
+            if !q.is_empty() {
+                for i in 0..s {
+                    init[i] += post.gamma[i];
+                }
+            }
+            for (t, v) in trans.iter_mut().zip(&post.xi_sum) {
+                *t += v;
+            }
+            gamma_all[row0 * s..(row0 + q.len()) * s].copy_from_slice(&post.gamma);
+            row0 += q.len();
+        }
         let obj = ll + hmm.log_prior(cfg.pseudo_count, sticky);
         objective.push(obj);
         progress(restart, it, obj);
@@ -469,35 +616,18 @@ fn em_run(
             }
         }
         // M-step.
-        let a = cfg.pseudo_count;
-        let mut init = vec![a; s];
-        let mut trans = vec![a; s * s];
-        for i in 0..s {
-            trans[i * s + i] += sticky;
-        }
-        for p in &posts {
-            if let Some(g0) = p.gamma.first() {
-                for i in 0..s {
-                    init[i] += g0[i];
-                }
-            }
-            for x in &p.xi {
-                for (t, v) in trans.iter_mut().zip(x) {
-                    *t += v;
-                }
-            }
-        }
         let z: f64 = init.iter().sum();
         init.iter_mut().for_each(|v| *v /= z);
         for i in 0..s {
             let z: f64 = trans[i * s..(i + 1) * s].iter().sum();
             trans[i * s..(i + 1) * s].iter_mut().for_each(|v| *v /= z);
         }
-        let flat_gamma: Vec<&Vec<f64>> = posts.iter().flat_map(|p| p.gamma.iter()).collect();
         let emit = (0..s)
             .map(|k| {
-                let w: Vec<f64> = flat_gamma.iter().map(|g| g[k]).collect();
-                Gaussian::fit_weighted(&owned, &w, eps, hmm.emit[k].mean().as_slice())
+                for (wt, g) in w.iter_mut().zip(gamma_all.chunks_exact(s)) {
+                    *wt = g[k];
+                }
+                Gaussian::fit_map(&owned, &w, prior, hmm.emit[k].mean().as_slice())
             })
             .collect();
         hmm = Hmm {
@@ -505,6 +635,7 @@ fn em_run(
             trans,
             emit,
             eps,
+            cov_prior: prior.clone(),
         };
     }
     let report = RunReport {
@@ -560,7 +691,8 @@ mod tests {
                     .collect()
             })
             .collect();
-        let post = forward_backward(&init, &trans, &log_b);
+        let flat: Vec<f64> = log_b.iter().flatten().copied().collect();
+        let post = forward_backward(&init, &trans, &flat);
         let (ll, marg) = brute(&init, &trans, &log_b);
         assert!(
             (post.log_likelihood - ll).abs() < 1e-10,
@@ -569,15 +701,18 @@ mod tests {
         );
         for t in 0..5 {
             for i in 0..3 {
-                assert!((post.gamma[t][i] - marg[t][i]).abs() < 1e-10);
+                assert!((post.gamma_at(t)[i] - marg[t][i]).abs() < 1e-10);
             }
         }
-        // Pairwise posteriors sum to the marginals.
-        for t in 0..4 {
-            for i in 0..3 {
-                let row: f64 = (0..3).map(|j| post.xi[t][i * 3 + j]).sum();
-                assert!((row - post.gamma[t][i]).abs() < 1e-10);
-            }
+        // Expected transition counts: rows sum to the marginals of steps 0..T-1, columns to
+        // those of steps 1..T.
+        for i in 0..3 {
+            let row: f64 = (0..3).map(|j| post.xi_sum[i * 3 + j]).sum();
+            let col: f64 = (0..3).map(|j| post.xi_sum[j * 3 + i]).sum();
+            let g_from: f64 = (0..4).map(|t| post.gamma_at(t)[i]).sum();
+            let g_to: f64 = (1..5).map(|t| post.gamma_at(t)[i]).sum();
+            assert!((row - g_from).abs() < 1e-10, "{row} vs {g_from}");
+            assert!((col - g_to).abs() < 1e-10, "{col} vs {g_to}");
         }
     }
 
@@ -632,7 +767,7 @@ mod tests {
         // Each true state maps to one fitted state on almost every step.
         let mut confusion = [[0usize; 3]; 3];
         for (s, t) in seqs.iter().zip(&truth) {
-            for (g, &q) in hmm.posterior(s).gamma.iter().zip(t) {
+            for (g, &q) in hmm.posterior(s).gamma_rows().zip(t) {
                 let best = (0..3)
                     .max_by(|&a, &b| g[a].partial_cmp(&g[b]).unwrap())
                     .unwrap();

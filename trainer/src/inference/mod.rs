@@ -1,4 +1,4 @@
-//! The inference layer (DESIGN.md, "Inference layer"): an HMM over kinematic parameters, a
+//! The inference layer (docs/method.md, "Inference layer"): an HMM over kinematic parameters, a
 //! Gaussian mixture over prosody, and the remapped CRF trained from the HMM's posteriors.
 
 // Index loops mirror the equations (alpha[t][i], xi[t][i * S + j]) and are kept on purpose.
@@ -11,4 +11,5 @@ pub mod gmm;
 pub mod hmm;
 pub mod model;
 pub mod quantize;
+pub mod select;
 pub mod train;

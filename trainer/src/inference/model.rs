@@ -19,8 +19,20 @@ use crate::motion::Normalization;
 
 /// Format tag of the model file.
 pub const FORMAT: &str = "gesture-inference-model";
-/// Current version of the model file.
-pub const VERSION: u32 = 1;
+/// Current version of the model file. Version 2 measures the kinematic parameters in body
+/// units (limb lengths, height above the shoulder, derivatives over 1/30 s;
+/// [`crate::motion::body`]); version 1 measured them in skeleton units with heights above the
+/// floor, so its normalization and state Gaussians do not apply to today's kinematics.
+pub const VERSION: u32 = 2;
+
+/// Why a model file of another version cannot be used.
+pub fn version_reason(found: u32) -> &'static str {
+    match found {
+        1 => "version 1 measured kinematics in skeleton units (cm, height above the floor), this build in limb lengths above the shoulder",
+        v if v > VERSION => "it was written by a newer build",
+        _ => "its layout is unknown to this build",
+    }
+}
 
 /// A Gaussian as stored (mean and row-major covariance).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -160,12 +172,14 @@ pub enum ModelError {
         reason: String,
     },
     /// Another version.
-    #[error("{path}: model format version {found}, this build reads version {VERSION}: retrain with `gesture-train fit`")]
+    #[error("{path}: model format version {found}, this build reads version {VERSION} ({reason}): retrain with `gesture-train fit`")]
     Version {
         /// The file.
         path: String,
         /// Version found.
         found: u32,
+        /// Why that version cannot be used.
+        reason: &'static str,
     },
 }
 
@@ -226,6 +240,7 @@ impl InferenceModel {
             return Err(ModelError::Version {
                 path: path.into(),
                 found: f.version,
+                reason: version_reason(f.version),
             });
         }
         let s = f.hmm.init.len();
@@ -273,6 +288,7 @@ impl InferenceModel {
             hmm: Hmm {
                 init: f.hmm.init,
                 trans: f.hmm.trans,
+                cov_prior: super::gaussian::CovPrior::floor(6, f.hmm.eps),
                 emit,
                 eps: f.hmm.eps,
             },

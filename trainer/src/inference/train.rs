@@ -1,6 +1,7 @@
-//! The inference-layer pipeline (DESIGN.md, inference layer steps 1-3): normalize the
+//! The inference-layer pipeline (docs/method.md, "Inference layer", steps 1-3): normalize the
 //! kinematic targets, fit the HMM on them, fit the prosody mixture, then train the CRF on the
-//! fixed HMM posteriors.
+//! fixed HMM posteriors. What the settings leave open (S, K, the CRF's regularization) is
+//! chosen first by held-out likelihood ([`super::select`]).
 
 use std::time::Instant;
 
@@ -10,6 +11,7 @@ use super::crf::{Crf, CrfConfig, TrainSeq};
 use super::gmm::{Gmm, GmmConfig, ProsodyPoint};
 use super::hmm::{Hmm, HmmConfig, HmmError, Seq};
 use super::model::InferenceModel;
+use super::select::{self, Selection};
 use crate::corpus::Corpus;
 use crate::motion::Normalization;
 
@@ -24,6 +26,9 @@ pub struct Sequence {
     pub y_raw: Vec<[f64; 6]>,
     /// Step start and end times (s).
     pub times: Vec<(f64, f64)>,
+    /// Start and end times (s) of the take's motion segments (for purging held-out data,
+    /// see [`super::select`]).
+    pub segments: Vec<(f64, f64)>,
 }
 
 impl Sequence {
@@ -34,6 +39,17 @@ impl Sequence {
     /// Whether empty.
     pub fn is_empty(&self) -> bool {
         self.features.is_empty()
+    }
+
+    /// The steps in `range` (same take, same segments).
+    pub fn slice(&self, range: std::ops::Range<usize>) -> Sequence {
+        Sequence {
+            stem: self.stem.clone(),
+            features: self.features[range.clone()].to_vec(),
+            y_raw: self.y_raw[range.clone()].to_vec(),
+            times: self.times[range].to_vec(),
+            segments: self.segments.clone(),
+        }
     }
 }
 
@@ -59,7 +75,9 @@ pub fn sequences(corpus: &Corpus, span: Option<(f64, f64)>) -> (Vec<Sequence>, V
         }
         let dt = t.motion.frame_time;
         for (g, y) in t.motion.segments.iter().zip(&t.motion.y_raw) {
-            if inside(g.start_frame as f64 * dt, g.end_frame as f64 * dt) {
+            let (g0, g1) = (g.start_frame as f64 * dt, g.end_frame as f64 * dt);
+            s.segments.push((g0, g1));
+            if inside(g0, g1) {
                 segs.push(*y);
             }
         }
@@ -78,13 +96,13 @@ pub fn prosody_point(f: &StepFeatures) -> ProsodyPoint {
     }
 }
 
-/// Settings of `fit`.
+/// Settings of `fit`. `None` means "choose from the data" (see [`super::select`]).
 #[derive(Clone, Copy, Debug)]
 pub struct FitConfig {
-    /// Hidden states S.
-    pub states: usize,
-    /// Prosody clusters K.
-    pub clusters: usize,
+    /// Hidden states S (`None`: by held-out likelihood).
+    pub states: Option<usize>,
+    /// Prosody clusters K (`None`: by held-out likelihood).
+    pub clusters: Option<usize>,
     /// CRF window W.
     pub window: usize,
     /// HMM restarts.
@@ -93,8 +111,11 @@ pub struct FitConfig {
     pub seed: u64,
     /// HMM stickiness (see [`HmmConfig::stickiness`]).
     pub stickiness: f64,
-    /// CRF L2 strength per training step; `None` chooses it by validation (see [`choose_l2`]).
+    /// CRF L2 strength per training step (`None`: by held-out likelihood).
     pub l2: Option<f64>,
+    /// Multiplier of the L2 strength on the CRF's lagged window weights (`None`: by held-out
+    /// likelihood; see [`super::crf`]).
+    pub lag_penalty: Option<f64>,
     /// Front-end rate the features came from.
     pub sample_rate_hz: u32,
 }
@@ -102,13 +123,14 @@ pub struct FitConfig {
 impl Default for FitConfig {
     fn default() -> Self {
         Self {
-            states: 12,
-            clusters: 12,
+            states: None,
+            clusters: None,
             window: 4,
             restarts: 16,
             seed: 1,
             stickiness: 0.0,
             l2: None,
+            lag_penalty: None,
             sample_rate_hz: gesture_runtime::prosody::DEFAULT_RATE_HZ,
         }
     }
@@ -163,8 +185,12 @@ pub struct FitReport {
     pub crf_objective: f64,
     /// CRF L2 used (per step).
     pub l2: f64,
-    /// Seconds per stage: HMM, GMM, CRF.
-    pub seconds: [f64; 3],
+    /// CRF lag penalty used.
+    pub lag_penalty: f64,
+    /// The model selection, when anything was chosen from the data.
+    pub selection: Option<Selection>,
+    /// Seconds per stage: model selection, HMM, GMM, CRF.
+    pub seconds: [f64; 4],
 }
 
 /// Normalized kinematic sequences.
@@ -204,27 +230,88 @@ fn check(cfg: &FitConfig) -> Result<(), FitError> {
     use gesture_runtime::inference::{MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
     let bad =
         |what: &str, max: usize| Err(FitError::Settings(format!("--{what} must be 1 to {max}")));
-    if !(1..=MAX_STATES).contains(&cfg.states) {
+    if cfg.states.is_some_and(|s| !(1..=MAX_STATES).contains(&s)) {
         return bad("states", MAX_STATES);
     }
-    if !(1..=MAX_CLUSTERS).contains(&cfg.clusters) {
+    if cfg
+        .clusters
+        .is_some_and(|k| !(1..=MAX_CLUSTERS).contains(&k))
+    {
         return bad("clusters", MAX_CLUSTERS);
     }
     if !(1..=MAX_WINDOW).contains(&cfg.window) {
         return bad("window", MAX_WINDOW);
     }
+    for (name, v) in [("l2", cfg.l2), ("lag-penalty", cfg.lag_penalty)] {
+        if v.is_some_and(|v| !(v.is_finite() && v >= 0.0)) {
+            return Err(FitError::Settings(format!(
+                "--{name} must be a finite number >= 0"
+            )));
+        }
+    }
     Ok(())
 }
 
-/// Fits normalization, HMM and mixture (everything but the CRF).
+/// Fits the kinematic HMM on normalized sequences `y`.
+pub fn fit_hmm(
+    y: &[Seq],
+    states: usize,
+    cfg: &FitConfig,
+    progress: impl Fn(usize, usize, f64) + Sync,
+) -> Result<(Hmm, Vec<super::hmm::RunReport>), FitError> {
+    let hcfg = HmmConfig {
+        states,
+        restarts: cfg.restarts,
+        seed: cfg.seed,
+        stickiness: cfg.stickiness,
+        ..HmmConfig::default()
+    };
+    Ok(Hmm::fit(y, &hcfg, progress)?)
+}
+
+/// Fits the prosody mixture on the steps of `seqs`; returns it and its objective per iteration.
+pub fn fit_gmm(seqs: &[Sequence], clusters: usize, seed: u64) -> Result<(Gmm, Vec<f64>), FitError> {
+    let points: Vec<ProsodyPoint> = seqs
+        .iter()
+        .flat_map(|s| s.features.iter().map(prosody_point))
+        .collect();
+    Gmm::fit(
+        &points,
+        &GmmConfig {
+            clusters,
+            seed,
+            ..GmmConfig::default()
+        },
+    )
+    .ok_or(FitError::Gmm {
+        steps: points.len(),
+        clusters,
+    })
+}
+
+/// CRF training sequences: memberships under `gmm`, posteriors under `hmm`.
+pub fn train_seqs(hmm: &Hmm, gmm: &Gmm, seqs: &[Sequence], y: &[Seq]) -> Vec<TrainSeq> {
+    seqs.iter()
+        .zip(y)
+        .map(|(s, ys)| TrainSeq::new(memberships(gmm, s), hmm.posterior(ys)))
+        .collect()
+}
+
+/// Fits normalization, HMM (`states`) and mixture (`clusters`): everything but the CRF.
 pub fn fit_base(
     seqs: &[Sequence],
     segment_y: &[[f64; 6]],
+    states: usize,
+    clusters: usize,
     cfg: &FitConfig,
     report: &mut FitReport,
     log: &(dyn Fn(&str) + Sync),
 ) -> Result<FitBase, FitError> {
-    check(cfg)?;
+    check(&FitConfig {
+        states: Some(states),
+        clusters: Some(clusters),
+        ..*cfg
+    })?;
     let steps: usize = seqs.iter().map(Sequence::len).sum();
     if steps == 0 {
         return Err(FitError::NoData);
@@ -235,14 +322,7 @@ pub fn fit_base(
     let y = normalized(seqs, &norm);
 
     let t0 = Instant::now();
-    let hcfg = HmmConfig {
-        states: cfg.states,
-        restarts: cfg.restarts,
-        seed: cfg.seed,
-        stickiness: cfg.stickiness,
-        ..HmmConfig::default()
-    };
-    let (hmm, runs) = Hmm::fit(&y, &hcfg, |r, it, obj| {
+    let (hmm, runs) = fit_hmm(&y, states, cfg, |r, it, obj| {
         if it % 10 == 0 {
             log(&format!(
                 "hmm restart {r} iteration {it}: objective {:.3} per step",
@@ -255,53 +335,25 @@ pub fn fit_base(
         .iter()
         .map(|r| r.log_likelihood)
         .fold(f64::NEG_INFINITY, f64::max);
-    report.seconds[0] = t0.elapsed().as_secs_f64();
+    report.seconds[1] = t0.elapsed().as_secs_f64();
     log(&format!(
-        "hmm: {} states, {} restarts, best log-likelihood {:.3} per step, {:.2} s",
-        cfg.states,
+        "hmm: {states} states, {} restarts, best log-likelihood {:.3} per step, {:.2} s",
         runs.len(),
         report.hmm_log_likelihood / steps as f64,
-        report.seconds[0]
+        report.seconds[1]
     ));
 
     let t1 = Instant::now();
-    let points: Vec<ProsodyPoint> = seqs
-        .iter()
-        .flat_map(|s| s.features.iter().map(prosody_point))
-        .collect();
-    let (gmm, gobj) = Gmm::fit(
-        &points,
-        &GmmConfig {
-            clusters: cfg.clusters,
-            seed: cfg.seed,
-            ..GmmConfig::default()
-        },
-    )
-    .ok_or(FitError::Gmm {
-        steps,
-        clusters: cfg.clusters,
-    })?;
+    let (gmm, gobj) = fit_gmm(seqs, clusters, cfg.seed)?;
     report.gmm_iterations = gobj.len();
-    report.seconds[1] = t1.elapsed().as_secs_f64();
+    report.seconds[2] = t1.elapsed().as_secs_f64();
     log(&format!(
-        "gmm: {} clusters, {} iterations, log-likelihood {:.3} per step, {:.2} s",
-        cfg.clusters,
+        "gmm: {clusters} clusters, {} iterations, log-likelihood {:.3} per step, {:.2} s",
         gobj.len(),
         gobj.last().copied().unwrap_or(0.0) / steps as f64,
-        report.seconds[1]
+        report.seconds[2]
     ));
-    let train: Vec<TrainSeq> = seqs
-        .iter()
-        .zip(&y)
-        .map(|(s, ys)| {
-            let post = hmm.posterior(ys);
-            TrainSeq {
-                memberships: memberships(&gmm, s),
-                gamma: post.gamma,
-                xi: post.xi,
-            }
-        })
-        .collect();
+    let train = train_seqs(&hmm, &gmm, seqs, &y);
     let state_prior = hmm.state_frequencies(&y);
     Ok(FitBase {
         normalization: norm,
@@ -313,120 +365,74 @@ pub fn fit_base(
     })
 }
 
-/// Candidate L2 strengths (per step) tried by [`choose_l2`].
-pub const L2_GRID: [f64; 4] = [1e-3, 1e-2, 0.1, 0.3];
-
-fn split_seq(q: &TrainSeq, cut: usize) -> (TrainSeq, TrainSeq) {
-    let cut = cut.clamp(1, q.memberships.len().saturating_sub(1).max(1));
-    let a = TrainSeq {
-        memberships: q.memberships[..cut].to_vec(),
-        gamma: q.gamma[..cut].to_vec(),
-        xi: q.xi[..cut.saturating_sub(1).min(q.xi.len())].to_vec(),
-    };
-    let b = TrainSeq {
-        memberships: q.memberships[cut..].to_vec(),
-        gamma: q.gamma[cut..].to_vec(),
-        xi: q.xi[cut.min(q.xi.len())..].to_vec(),
-    };
-    (a, b)
-}
-
-/// Chooses the CRF's L2 strength by validation: trains on the first 80% of every training
-/// sequence and scores the last 20% with the CRF's own objective (expected log-likelihood of
-/// the HMM posteriors, no penalty), for each value of [`L2_GRID`]. How much to regularize
-/// depends on how much data there is and how predictable the states are from prosody, so it
-/// is measured rather than fixed. Returns the best value and its held-out score per step.
-pub fn choose_l2(
-    base: &FitBase,
-    window: usize,
-    log: &(dyn Fn(&str) + Sync),
-) -> Result<(f64, f64), FitError> {
-    let (fit_part, held): (Vec<TrainSeq>, Vec<TrainSeq>) = base
-        .train
-        .iter()
-        .filter(|q| q.memberships.len() >= 10)
-        .map(|q| split_seq(q, q.memberships.len() * 4 / 5))
-        .unzip();
-    let held_steps: usize = held.iter().map(|q| q.memberships.len()).sum();
-    let fit_steps: usize = fit_part.iter().map(|q| q.memberships.len()).sum();
-    if held_steps == 0 {
-        return Ok((1e-2, f64::NAN));
-    }
-    let (s, k) = (base.hmm.states(), base.gmm.components.len());
-    let mut best = (L2_GRID[0], f64::NEG_INFINITY);
-    for &l2 in &L2_GRID {
-        let cfg = CrfConfig {
-            window,
-            l2: l2 * fit_steps as f64,
-            ..CrfConfig::default()
-        };
-        let (crf, _) = Crf::fit(&fit_part, s, k, &cfg).map_err(FitError::Crf)?;
-        let score = crf.objective_and_gradient(&held, 0.0).0 / held_steps as f64;
-        log(&format!(
-            "crf: window {window}, l2 {l2}: held-out objective {score:.4} per step"
-        ));
-        if score > best.1 {
-            best = (l2, score);
-        }
-    }
-    Ok(best)
-}
-
-/// Trains the CRF for window `window` on a fitted base (`l2` per step; `None`: by validation).
+/// Trains the CRF for window `window` on a fitted base with L2 strength `l2` per training
+/// step and lag penalty `lag_penalty` (see [`super::crf`]).
 pub fn fit_crf(
     base: &FitBase,
     window: usize,
-    l2: Option<f64>,
+    l2: f64,
+    lag_penalty: f64,
     report: &mut FitReport,
     log: &(dyn Fn(&str) + Sync),
 ) -> Result<Crf, FitError> {
     let t2 = Instant::now();
-    let l2 = match l2 {
-        Some(v) => v,
-        None => choose_l2(base, window, log)?.0,
-    };
     report.l2 = l2;
+    report.lag_penalty = lag_penalty;
+    let steps = base
+        .train
+        .iter()
+        .map(|q| q.memberships.len())
+        .sum::<usize>();
+    let center = Crf::prior(&base.state_prior, base.gmm.components.len(), window);
     // `l2` is per training step: the objective is a sum over steps, so the penalty scales
     // with them and the regularization strength does not depend on the corpus size.
     let (crf, crep) = Crf::fit(
         &base.train,
-        base.hmm.states(),
-        base.gmm.components.len(),
+        &center,
+        None,
         &CrfConfig {
             window,
-            l2: l2 * report.steps.max(1) as f64,
+            l2: l2 * steps.max(1) as f64,
+            lag_penalty,
             ..CrfConfig::default()
         },
     )
     .map_err(FitError::Crf)?;
     report.crf_iterations = crep.iterations;
-    report.crf_objective = crep.objective / report.steps.max(1) as f64;
-    report.seconds[2] = t2.elapsed().as_secs_f64();
+    report.crf_objective = crep.objective / steps.max(1) as f64;
+    report.seconds[3] = t2.elapsed().as_secs_f64();
     log(&format!(
-        "crf: window {window}, l2 {l2}, {} L-BFGS iterations ({}), objective {:.4} per step, {:.2} s",
-        crep.iterations, crep.termination, report.crf_objective, report.seconds[2]
+        "crf: window {window}, l2 {l2}, lag penalty {lag_penalty}, {} L-BFGS iterations ({}), \
+         objective {:.4} per step, {:.2} s",
+        crep.iterations, crep.termination, report.crf_objective, report.seconds[3]
     ));
     Ok(crf)
 }
 
-/// Fits the whole inference layer. `log` receives progress lines.
+/// Fits the whole inference layer, choosing what `cfg` leaves open by held-out likelihood
+/// ([`super::select`]). `log` receives progress lines.
 pub fn fit(
     seqs: &[Sequence],
     segment_y: &[[f64; 6]],
     cfg: &FitConfig,
     log: &(dyn Fn(&str) + Sync),
 ) -> Result<(InferenceModel, FitReport), FitError> {
+    check(cfg)?;
     let mut report = FitReport::default();
-    let base = fit_base(seqs, segment_y, cfg, &mut report, log)?;
-    let crf = fit_crf(&base, cfg.window, cfg.l2, &mut report, log)?;
+    let t0 = Instant::now();
+    let choice = select::choose(seqs, segment_y, cfg, &[cfg.window], log)?;
+    report.seconds[0] = t0.elapsed().as_secs_f64();
+    let (states, clusters) = (choice.states, choice.clusters);
+    let (l2, lag_penalty) = choice.regularization[0];
+    report.selection = choice.selection;
+    let base = fit_base(seqs, segment_y, states, clusters, cfg, &mut report, log)?;
+    let crf = fit_crf(&base, cfg.window, l2, lag_penalty, &mut report, log)?;
     let summary = format!(
-        "{} steps in {} sequences; S={} K={} W={} l2={}; HMM ll/step {:.3}; CRF objective/step {:.4}",
+        "{} steps in {} sequences; S={states} K={clusters} W={} l2={l2} lag penalty={lag_penalty}; \
+         HMM ll/step {:.3}; CRF objective/step {:.4}",
         report.steps,
         seqs.len(),
-        cfg.states,
-        cfg.clusters,
         cfg.window,
-        report.l2,
         report.hmm_log_likelihood / report.steps as f64,
         report.crf_objective
     );

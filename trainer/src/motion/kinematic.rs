@@ -1,5 +1,9 @@
 //! The six kinematic parameters of a segment, y = (T, D, V, A, C, H), and their corpus
-//! normalization (the paper's W and B; DESIGN.md, "Kinematic parameters").
+//! normalization (the paper's W and B; docs/method.md, "Data and time steps").
+//!
+//! [`crate::motion::analyze`] measures them in *body units* ([`super::body`]: limb lengths,
+//! height above the shoulder, derivatives over 1/30 s); [`segment_kinematics`] below is the
+//! same definitions in skeleton units, kept for callers that want physical values.
 //!
 //! Owns the definitions below; [`Kinematics`] holds the physical values, [`Kinematics::log`]
 //! the log-scale vector `y_raw`, [`Normalization`] the fitted affine map to `y`.

@@ -9,6 +9,7 @@
 //! | [`effectors`] | which points to follow: the two hands by name, or any named joints |
 //! | [`segment`] | mean effector speed, threshold cuts with hysteresis and a minimum length |
 //! | [`kinematic`] | y = (T, D, V, A, C, H) per segment, log scale, corpus [`Normalization`] |
+//! | [`body`] | the body units [`analyze`] measures y in: limb lengths, height above the shoulder, derivatives over 1/30 s |
 //!
 //! [`analyze`] chains them for one take; it is what the corpus loader calls.
 //!
@@ -20,6 +21,7 @@
 //! that gate returns results or typed errors (bad parameters, missing joints). Everything is
 //! `f64` and single-threaded; allocation is proportional to the take's size.
 
+pub mod body;
 pub mod bvh_read;
 pub mod bvh_write;
 pub mod effectors;
@@ -58,7 +60,9 @@ pub struct TakeAnalysis {
     pub floor: f64,
     /// The segments, tiling the take.
     pub segments: Vec<Segment>,
-    /// Physical kinematic parameters per segment.
+    /// The body's limb length (skeleton units), the unit of the kinematics ([`body`]).
+    pub limb_length: f64,
+    /// Kinematic parameters per segment, in body units ([`body`]).
     pub kinematics: Vec<Kinematics>,
     /// `ln(value + eps)` per segment: the un-normalized y vectors.
     pub y_raw: Vec<[f64; 6]>,
@@ -79,10 +83,13 @@ pub enum AnalysisError {
     /// A kinematic parameter is out of range.
     #[error(transparent)]
     Kinematic(#[from] KinematicParamError),
+    /// An effector has no limb to measure by.
+    #[error(transparent)]
+    Body(#[from] body::BodyError),
 }
 
-/// Segments one take and computes its kinematic parameters, with default
-/// [`KinematicParams`] (Y up, floor at the lowest point of the take).
+/// Segments one take and computes its kinematic parameters in body units ([`body`]), with
+/// default [`KinematicParams`] (Y up).
 pub fn analyze(
     motion: &Motion,
     effectors: &EffectorSpec,
@@ -107,8 +114,14 @@ pub fn analyze_with(
         HeightReference::Floor(h) => h,
         HeightReference::LowestPoint => lowest_point(motion, kin.up_axis)?,
     };
-    let kinematics =
-        kinematic::segment_kinematics(&positions, motion.frame_time(), &seg.segments, floor, kin)?;
+    let limbs = body::limbs(motion, &effectors)?;
+    let kinematics = body::segment_kinematics(
+        &positions,
+        &limbs,
+        motion.frame_time(),
+        &seg.segments,
+        kin.up_axis,
+    );
     let y_raw = kinematics.iter().map(|k| k.log(&kin.eps)).collect();
     Ok(TakeAnalysis {
         source: motion.source().to_string(),
@@ -118,6 +131,7 @@ pub fn analyze_with(
         speed: seg.speed,
         threshold: seg.threshold,
         floor,
+        limb_length: limbs.length,
         segments: seg.segments,
         kinematics,
         y_raw,
