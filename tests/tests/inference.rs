@@ -58,7 +58,7 @@ fn limbs_measure_the_same_arm_on_both_zeroeggs_skeletons_and_bandais_shorter_one
             46.6,
         ),
     ] {
-        let m = read_bvh(&root.join(file)).unwrap();
+        let m = read_bvh(root.join(file)).unwrap();
         let a = analyze(&m, &EffectorSpec::default(), &SegmentParams::default()).unwrap();
         let l = a.limb_length;
         assert!((l - want).abs() < 0.1, "{file}: limb {l} cm, want {want}");
