@@ -424,8 +424,25 @@ fn run_streams_vmc_bundles_a_receiver_decodes() {
         }
         got
     });
+    // Three seconds of the utterance, paced in real time (as a receiver wants it; a flood of
+    // datagrams would overrun the socket's buffer on a busy machine).
+    let short = s.root.join("vmc-3s.wav");
+    {
+        let mut r = hound::WavReader::open(&s.wav).unwrap();
+        let spec = r.spec();
+        let n = 3 * spec.sample_rate as usize * spec.channels as usize;
+        let samples: Vec<i16> = r.samples::<i16>().take(n).map(Result::unwrap).collect();
+        let mut w = hound::WavWriter::create(&short, spec).unwrap();
+        samples.iter().for_each(|&x| w.write_sample(x).unwrap());
+        w.finalize().unwrap();
+    }
     let out = s.root.join("out-vmc");
-    let o = run_into(&s.full, &s.wav, &out, &["--no-video", "--vmc", &addr]);
+    let o = run_into(
+        &s.full,
+        &short,
+        &out,
+        &["--no-video", "--realtime", "--vmc", &addr],
+    );
     assert!(o.status.success(), "{}", text(&o.stderr));
     let stdout = text(&o.stdout);
     assert!(stdout.contains("vmc: sent"), "{stdout}");
