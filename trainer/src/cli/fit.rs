@@ -34,7 +34,8 @@ pub struct FitArgs {
 /// Runs the command.
 pub fn run(a: &FitArgs) -> Result<(), CliError> {
     let start = Instant::now();
-    let corpus = load_corpus(&a.corpus, &a.load.options())?;
+    let load = a.load.options();
+    let corpus = load_corpus(&a.corpus, &load)?;
     let (seqs, segs) = sequences(&corpus, a.span);
     let steps: usize = seqs.iter().map(|s| s.len()).sum();
     eprintln!(
@@ -43,7 +44,10 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
         segs.len(),
         corpus.load_s
     );
-    let cfg = a.model.config(a.window);
+    let mut cfg = a.model.config(a.window);
+    // The model records the front end its features came from.
+    cfg.prosody = load.prosody;
+    cfg.sample_rate_hz = load.prosody.sample_rate_hz;
     let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;
     model.save(&a.out)?;
     if let Some(sel) = &report.selection {

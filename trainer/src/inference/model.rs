@@ -8,6 +8,7 @@
 
 use std::path::Path;
 
+use gesture_runtime::prosody::{PitchParams, ProsodyConfig, SyllableParams};
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 
@@ -103,11 +104,86 @@ pub struct CrfFile {
     pub obs: Vec<f64>,
 }
 
-/// Front-end settings the model was trained with (the device must use the same).
+/// Front-end settings the model was trained with, all of them (`pack` writes exactly these
+/// into the blob, so a later change of the defaults cannot silently change what an old model's
+/// device computes). Field meanings: `gesture_runtime::prosody::{PitchParams, SyllableParams}`.
 #[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq)]
 pub struct FrontEndFile {
     /// Sample rate (Hz).
     pub sample_rate_hz: u32,
+    /// Pitch floor (Hz).
+    pub pitch_floor_hz: f32,
+    /// Pitch ceiling (Hz).
+    pub pitch_ceiling_hz: f32,
+    /// Pitch silence threshold.
+    pub silence_threshold: f32,
+    /// Pitch voicing threshold.
+    pub voicing_threshold: f32,
+    /// Pitch octave cost.
+    pub octave_cost: f32,
+    /// Pitch octave-jump cost.
+    pub octave_jump_cost: f32,
+    /// Pitch voiced/unvoiced cost.
+    pub voiced_unvoiced_cost: f32,
+    /// Syllable margin (dB).
+    pub margin_db: f32,
+    /// Syllable range (dB).
+    pub range_db: f32,
+    /// Syllable floor (dB).
+    pub floor_db: f32,
+    /// Syllable initial peak (dB).
+    pub initial_peak_db: f32,
+    /// Shortest syllable (frames).
+    pub min_frames: u32,
+    /// Pause step length (frames).
+    pub pause_frames: u32,
+}
+
+impl From<&ProsodyConfig> for FrontEndFile {
+    fn from(c: &ProsodyConfig) -> Self {
+        Self {
+            sample_rate_hz: c.sample_rate_hz,
+            pitch_floor_hz: c.pitch.floor_hz,
+            pitch_ceiling_hz: c.pitch.ceiling_hz,
+            silence_threshold: c.pitch.silence_threshold,
+            voicing_threshold: c.pitch.voicing_threshold,
+            octave_cost: c.pitch.octave_cost,
+            octave_jump_cost: c.pitch.octave_jump_cost,
+            voiced_unvoiced_cost: c.pitch.voiced_unvoiced_cost,
+            margin_db: c.syllables.margin_db,
+            range_db: c.syllables.range_db,
+            floor_db: c.syllables.floor_db,
+            initial_peak_db: c.syllables.initial_peak_db,
+            min_frames: c.syllables.min_frames,
+            pause_frames: c.syllables.pause_frames,
+        }
+    }
+}
+
+impl FrontEndFile {
+    /// The front-end configuration (not yet validated).
+    pub fn config(&self) -> ProsodyConfig {
+        ProsodyConfig {
+            sample_rate_hz: self.sample_rate_hz,
+            pitch: PitchParams {
+                floor_hz: self.pitch_floor_hz,
+                ceiling_hz: self.pitch_ceiling_hz,
+                silence_threshold: self.silence_threshold,
+                voicing_threshold: self.voicing_threshold,
+                octave_cost: self.octave_cost,
+                octave_jump_cost: self.octave_jump_cost,
+                voiced_unvoiced_cost: self.voiced_unvoiced_cost,
+            },
+            syllables: SyllableParams {
+                margin_db: self.margin_db,
+                range_db: self.range_db,
+                floor_db: self.floor_db,
+                initial_peak_db: self.initial_peak_db,
+                min_frames: self.min_frames,
+                pause_frames: self.pause_frames,
+            },
+        }
+    }
 }
 
 /// The whole model file.
@@ -136,8 +212,10 @@ pub struct ModelFile {
 /// A model in memory.
 #[derive(Clone, Debug)]
 pub struct InferenceModel {
-    /// Front-end rate.
+    /// Front-end rate (`prosody.sample_rate_hz`).
     pub sample_rate_hz: u32,
+    /// The front-end settings the features were computed with.
+    pub prosody: ProsodyConfig,
     /// Kinematic normalization.
     pub normalization: Normalization,
     /// HMM.
@@ -194,9 +272,7 @@ impl InferenceModel {
         ModelFile {
             format: FORMAT.into(),
             version: VERSION,
-            front_end: FrontEndFile {
-                sample_rate_hz: self.sample_rate_hz,
-            },
+            front_end: FrontEndFile::from(&self.prosody),
             normalization: self.normalization,
             hmm: HmmFile {
                 init: self.hmm.init.clone(),
@@ -243,11 +319,17 @@ impl InferenceModel {
                 reason: version_reason(f.version),
             });
         }
+        let prosody = f.front_end.config();
+        prosody
+            .validate()
+            .map_err(|e| bad(format!("front-end settings: {e}")))?;
         let s = f.hmm.init.len();
         let k = f.gmm.len();
         let w = f.crf.window;
+        // Checked products: a file's dimensions must not wrap around.
+        let square = s.checked_mul(s);
         if s == 0
-            || f.hmm.trans.len() != s * s
+            || Some(f.hmm.trans.len()) != square
             || f.hmm.states.len() != s
             || f.state_prior.len() != s
         {
@@ -256,8 +338,8 @@ impl InferenceModel {
         if k == 0
             || w == 0
             || f.crf.init.len() != s
-            || f.crf.trans.len() != s * s
-            || f.crf.obs.len() != s * w * k
+            || Some(f.crf.trans.len()) != square
+            || Some(f.crf.obs.len()) != s.checked_mul(w).and_then(|x| x.checked_mul(k))
         {
             return Err(bad("inconsistent CRF dimensions".into()));
         }
@@ -283,7 +365,8 @@ impl InferenceModel {
             .collect::<Option<Vec<_>>>()
             .ok_or_else(|| bad("a prosody cluster is not valid".into()))?;
         Ok(Self {
-            sample_rate_hz: f.front_end.sample_rate_hz,
+            sample_rate_hz: prosody.sample_rate_hz,
+            prosody,
             normalization: f.normalization,
             hmm: Hmm {
                 init: f.hmm.init,

@@ -118,6 +118,9 @@ pub struct FitConfig {
     pub lag_penalty: Option<f64>,
     /// Front-end rate the features came from.
     pub sample_rate_hz: u32,
+    /// The front-end settings the features were computed with (recorded in the model; the
+    /// sample rate is `sample_rate_hz`).
+    pub prosody: gesture_runtime::prosody::ProsodyConfig,
 }
 
 impl Default for FitConfig {
@@ -132,6 +135,7 @@ impl Default for FitConfig {
             l2: None,
             lag_penalty: None,
             sample_rate_hz: gesture_runtime::prosody::DEFAULT_RATE_HZ,
+            prosody: gesture_runtime::prosody::ProsodyConfig::DEFAULT,
         }
     }
 }
@@ -428,10 +432,11 @@ pub fn fit(
     let base = fit_base(seqs, segment_y, states, clusters, cfg, &mut report, log)?;
     let crf = fit_crf(&base, cfg.window, l2, lag_penalty, &mut report, log)?;
     let summary = format!(
-        "{} steps in {} sequences; S={states} K={clusters} W={} l2={l2} lag penalty={lag_penalty}; \
+        "{} steps in {} sequence{}; S={states} K={clusters} W={} l2={l2} lag penalty={lag_penalty}; \
          HMM ll/step {:.3}; CRF objective/step {:.4}",
         report.steps,
         seqs.len(),
+        if seqs.len() == 1 { "" } else { "s" },
         cfg.window,
         report.hmm_log_likelihood / report.steps as f64,
         report.crf_objective
@@ -439,6 +444,10 @@ pub fn fit(
     Ok((
         InferenceModel {
             sample_rate_hz: cfg.sample_rate_hz,
+            prosody: gesture_runtime::prosody::ProsodyConfig {
+                sample_rate_hz: cfg.sample_rate_hz,
+                ..cfg.prosody
+            },
             normalization: base.normalization,
             hmm: base.hmm,
             gmm: base.gmm,

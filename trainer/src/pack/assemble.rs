@@ -95,10 +95,8 @@ pub fn parts(
         .iter()
         .map(|c| (c.name.clone(), c.cal))
         .collect();
-    let config = ProsodyConfig {
-        sample_rate_hz: model.sample_rate_hz,
-        ..ProsodyConfig::DEFAULT
-    };
+    // Exactly what the model's features were computed with (recorded in the model file).
+    let config: ProsodyConfig = model.prosody;
     config
         .validate()
         .map_err(|e| PackError::FrontEnd(format!("the model's front-end settings: {e}")))?;
