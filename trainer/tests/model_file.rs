@@ -62,7 +62,7 @@ fn the_front_end_goes_from_model_file_to_blob_and_bad_files_are_refused() {
         v["front_end"]["pause_frames"] = 30.into();
     });
     let m2 = InferenceModel::load(&other).unwrap();
-    let packed = pack_model(&m2, &[c.clone()], &PackOptions::default()).unwrap();
+    let packed = pack_model(&m2, std::slice::from_ref(&c), &PackOptions::default()).unwrap();
     let cfg = Blob::parse(&packed.bytes).unwrap().prosody_config();
     assert_eq!(cfg.pitch.floor_hz, 100.0);
     assert_eq!(cfg.syllables.pause_frames, 30);
