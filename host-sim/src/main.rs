@@ -1,7 +1,8 @@
 //! `gesture-sim`: parses the command line and hands it to [`host_sim::cli`].
 
-use clap::Parser;
-
 fn main() -> std::process::ExitCode {
-    host_sim::cli::run(&host_sim::cli::Cli::parse())
+    match gesture_trainer::cli::parse_args::<host_sim::cli::Cli>("gesture-sim") {
+        Ok(cli) => host_sim::cli::run(&cli),
+        Err(code) => code,
+    }
 }

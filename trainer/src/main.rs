@@ -2,10 +2,11 @@
 
 use std::process::ExitCode;
 
-use clap::Parser;
-
 fn main() -> ExitCode {
-    let cli = gesture_trainer::cli::Cli::parse();
+    let cli = match gesture_trainer::cli::parse_args::<gesture_trainer::cli::Cli>("gesture-train") {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
     match gesture_trainer::cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -82,3 +82,98 @@ fn a_closed_stdout_pipe_ends_quietly() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(out.status.code(), Some(0));
 }
+
+/// Numeric options are checked when the command line is parsed: NaN, infinities, negative or
+/// out-of-range values are one line naming the flag, exit 2, before any input is read (`fit
+/// --l2 nan` used to hang in the line search).
+#[test]
+fn bad_numbers_are_refused_at_parse_time_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_path = dir.path().join("m.json");
+    let out = out_path.to_str().unwrap();
+    let cases: [(&[&str], &str); 12] = [
+        (
+            &["fit", "--corpus", "x", "--out", out, "--l2", "nan"],
+            "--l2",
+        ),
+        (
+            &["fit", "--corpus", "x", "--out", out, "--l2", "inf"],
+            "--l2",
+        ),
+        (&["fit", "--corpus", "x", "--out", out, "--l2", "0"], "--l2"),
+        (
+            &["fit", "--corpus", "x", "--out", out, "--stickiness", "nan"],
+            "--stickiness",
+        ),
+        (
+            &["fit", "--corpus", "x", "--out", out, "--lag-penalty=-1"],
+            "--lag-penalty",
+        ),
+        (
+            &["fit", "--corpus", "x", "--out", out, "--states", "0"],
+            "--states",
+        ),
+        (
+            &["fit", "--corpus", "x", "--out", out, "--states", "33"],
+            "--states",
+        ),
+        (
+            &["fit", "--corpus", "x", "--out", out, "--window", "9"],
+            "--window",
+        ),
+        (
+            &[
+                "fit",
+                "--corpus",
+                "x",
+                "--out",
+                out,
+                "--max-mismatch",
+                "NaN",
+            ],
+            "--max-mismatch",
+        ),
+        (
+            &[
+                "pack",
+                "--model",
+                "m",
+                "--library",
+                "l",
+                "--out",
+                out,
+                "--usage-cost",
+                "inf",
+            ],
+            "--usage-cost",
+        ),
+        (
+            &[
+                "pack",
+                "--model",
+                "m",
+                "--library",
+                "l",
+                "--out",
+                out,
+                "--transition-weight",
+                "nan",
+            ],
+            "--transition-weight",
+        ),
+        (&["synth", "--minutes", "nan", "--out", out], "--minutes"),
+    ];
+    for (args, flag) in cases {
+        let o = run(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.starts_with("gesture-train: ") && err.contains(flag),
+            "{args:?}: {err}"
+        );
+        assert!(!out_path.exists());
+    }
+    // --help still prints and succeeds.
+    assert!(run(&["fit", "--help"]).status.success());
+}

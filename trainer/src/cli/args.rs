@@ -5,6 +5,67 @@ use gesture_runtime::controller::DecisionTiming;
 
 use super::CliError;
 
+/// A finite number in `lo..=hi`, or the reason it is not (clap prints it with the flag).
+fn bounded(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be a finite number from {lo} to {hi}"))
+    }
+}
+
+/// A whole number in `lo..=hi`.
+pub fn count(s: &str, lo: usize, hi: usize) -> Result<usize, String> {
+    let v: usize = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?} is not a whole number"))?;
+    if (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be from {lo} to {hi}"))
+    }
+}
+
+/// [`bounded`] for other command files.
+pub fn bounded_pub(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
+    bounded(s, lo, hi)
+}
+
+/// A weight or cost: finite, 0 to 1e6.
+pub fn weight(s: &str) -> Result<f64, String> {
+    bounded(s, 0.0, 1.0e6)
+}
+
+/// A cost stored in the blob as `f32`: finite, 0 to 1e6 (the blob's limit).
+pub fn cost_f32(s: &str) -> Result<f32, String> {
+    bounded(s, 0.0, f64::from(gesture_runtime::blob::MAX_VARIETY_COST)).map(|v| v as f32)
+}
+
+/// A regularization strength: finite, more than 0, at most 1e6.
+pub fn strength(s: &str) -> Result<f64, String> {
+    let v = bounded(s, 0.0, 1.0e6)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err("must be more than 0".into())
+    }
+}
+
+/// Seconds of audio/motion mismatch: finite, 0 to 60.
+pub fn mismatch_s(s: &str) -> Result<f64, String> {
+    bounded(s, 0.0, 60.0)
+}
+
+/// HMM stickiness: finite, 0 to 100.
+pub fn stickiness(s: &str) -> Result<f64, String> {
+    bounded(s, 0.0, 100.0)
+}
+
 /// Options shared by commands that read a corpus.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CorpusArgs {
@@ -12,7 +73,7 @@ pub struct CorpusArgs {
     #[arg(long, value_delimiter = ',')]
     pub effectors: Vec<String>,
     /// Largest accepted difference between audio and motion length, in seconds.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = mismatch_s)]
     pub max_mismatch: f64,
 }
 
@@ -33,14 +94,14 @@ impl CorpusArgs {
 pub struct ControlArgs {
     /// Weight of transition costs against the fit of a segment to the belief (lower: gestures
     /// follow the speech more and the recorded order less, with more cuts).
-    #[arg(long, default_value_t = crate::control::costs::CostParams::default().transition_weight)]
+    #[arg(long, default_value_t = crate::control::costs::CostParams::default().transition_weight, value_parser = weight)]
     pub transition_weight: f64,
     /// Weight of the pose jump when a segment ends in a cut (not scaled by the transition
     /// weight).
-    #[arg(long, default_value_t = crate::control::costs::CostParams::default().junction_weight)]
+    #[arg(long, default_value_t = crate::control::costs::CostParams::default().junction_weight, value_parser = weight)]
     pub junction_weight: f64,
     /// Added to the cost of leaving a segment at an interruption frame.
-    #[arg(long, default_value_t = crate::control::costs::CostParams::default().interruption_penalty)]
+    #[arg(long, default_value_t = crate::control::costs::CostParams::default().interruption_penalty, value_parser = weight)]
     pub interruption_penalty: f64,
 }
 
@@ -73,27 +134,27 @@ impl ControlArgs {
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelArgs {
     /// Hidden states S (default: chosen by held-out likelihood).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| count(s, 1, gesture_runtime::inference::MAX_STATES))]
     pub states: Option<usize>,
     /// Prosody clusters K (default: chosen by held-out likelihood).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| count(s, 1, gesture_runtime::inference::MAX_CLUSTERS))]
     pub clusters: Option<usize>,
     /// HMM restarts (run in parallel; EM finds better optima with more).
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = |s: &str| count(s, 1, 1000))]
     pub restarts: usize,
     /// Seed.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// CRF L2 regularization per training step, toward the CRF that learned nothing (default:
     /// chosen by held-out likelihood, per window).
-    #[arg(long)]
+    #[arg(long, value_parser = strength)]
     pub l2: Option<f64>,
     /// Multiplier of the L2 strength on the CRF's older window steps (default: chosen by
     /// held-out likelihood from 1, 10, 100).
-    #[arg(long)]
+    #[arg(long, value_parser = strength)]
     pub lag_penalty: Option<f64>,
     /// HMM stickiness: extra self-transition pseudo-count as a fraction of steps per state.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = stickiness)]
     pub stickiness: f64,
 }
 
@@ -144,30 +205,30 @@ pub struct DeviceArgs {
     #[arg(long)]
     pub immediate: bool,
     /// An onset detected this recently counts as "now" (ms).
-    #[arg(long, default_value_t = DecisionTiming::DEFAULT.onset_window_ms)]
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.onset_window_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_ONSET_WINDOW_MS as i64))]
     pub onset_window_ms: u32,
     /// Longest wait for an onset at a segment's end (ms; the body runs on meanwhile).
-    #[arg(long, default_value_t = DecisionTiming::DEFAULT.max_wait_ms)]
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.max_wait_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_WAIT_MS as i64))]
     pub max_wait_ms: u32,
     /// Longest hold at a motion beat (a pause of the hands) waiting for an onset (ms; 0: no
     /// holds).
-    #[arg(long, default_value_t = DecisionTiming::DEFAULT.beat_hold_ms)]
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.beat_hold_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_BEAT_HOLD_MS as i64))]
     pub beat_hold_ms: u32,
     /// Cost of entering a segment entered just now, falling to 0 over --recency-ms (0: no
     /// recency cost).
-    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_cost)]
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_cost, value_parser = cost_f32)]
     pub recency_cost: f32,
     /// Recency window (ms).
-    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_ms)]
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_ms, value_parser = clap::value_parser!(u32).range(0..=u16::MAX as i64))]
     pub recency_ms: u32,
     /// Cost per unit of a segment's share of the frames played in the last --usage-ms.
-    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_cost)]
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_cost, value_parser = cost_f32)]
     pub usage_cost: f32,
     /// Usage window (ms).
-    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_ms)]
+    #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_ms, value_parser = clap::value_parser!(u32).range(0..=u16::MAX as i64))]
     pub usage_ms: u32,
     /// Inertialization time at cuts (ms; 0: hard cuts).
-    #[arg(long, default_value_t = crate::pack::DEFAULT_BLEND_MS)]
+    #[arg(long, default_value_t = crate::pack::DEFAULT_BLEND_MS, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_BLEND_MS as i64))]
     pub blend_ms: u32,
     /// Play the library's legs as captured (feet may slide) instead of holding the lower
     /// body in a standing pose.

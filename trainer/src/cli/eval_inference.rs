@@ -28,7 +28,7 @@ pub struct EvalArgs {
     #[arg(long, required = true, num_args = 1..)]
     pub test: Vec<PathBuf>,
     /// CRF windows to compare.
-    #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2, 3, 4, 5])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2, 3, 4, 5], value_parser = |s: &str| super::args::count(s, 1, gesture_runtime::inference::MAX_WINDOW))]
     pub windows: Vec<usize>,
     /// Use only training steps in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]

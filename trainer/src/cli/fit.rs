@@ -15,7 +15,7 @@ pub struct FitArgs {
     #[arg(long, required = true, num_args = 1..)]
     pub corpus: Vec<PathBuf>,
     /// CRF input window W (syllables, causal).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, value_parser = |s: &str| super::args::count(s, 1, gesture_runtime::inference::MAX_WINDOW))]
     pub window: usize,
     /// Use only steps whose midpoint is in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]

@@ -173,6 +173,33 @@ pub(crate) fn write_line(args: std::fmt::Arguments<'_>) -> Result<(), CliError> 
     })
 }
 
+/// Parses the command line of `bin` like clap, but a bad command line is one line on stderr
+/// (`bin: invalid value 'nan' for '--l2 <L2>': ... (see --help)`) and exit status 2, as every
+/// other bad input; `--help` and `--version` print as usual and succeed.
+pub fn parse_args<T: Parser>(bin: &str) -> Result<T, std::process::ExitCode> {
+    use clap::error::ErrorKind;
+    T::try_parse().map_err(|e| match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            let _ = e.print();
+            std::process::ExitCode::SUCCESS
+        }
+        _ => {
+            eprintln!("{bin}: {}", one_line(&e.render().to_string()));
+            std::process::ExitCode::from(2)
+        }
+    })
+}
+
+/// The first line of a clap message without its `error: ` prefix, pointing to `--help`.
+fn one_line(rendered: &str) -> String {
+    let first = rendered
+        .lines()
+        .find(|l| !l.trim().is_empty())
+        .unwrap_or("");
+    let first = first.strip_prefix("error: ").unwrap_or(first);
+    format!("{first} (see --help)")
+}
+
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {

@@ -20,7 +20,7 @@ pub struct PackArgs {
     #[arg(long)]
     pub rig: Option<PathBuf>,
     /// Largest blob size in bytes; successor lists are truncated to fit (with regret reported).
-    #[arg(long)]
+    #[arg(long, value_parser = |s: &str| super::args::count(s, 1, usize::MAX))]
     pub budget_bytes: Option<usize>,
     /// Output blob.
     #[arg(long)]
