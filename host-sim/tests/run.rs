@@ -552,6 +552,25 @@ fn blender_script_and_speech_sit_next_to_the_motion() {
     assert!(!out.join("blender.py").exists() && !out.join("speech.wav").exists());
 }
 
+/// A run never writes over its inputs: audio named like an output in the output folder is
+/// refused in one line, exit 2, the audio unchanged.
+#[test]
+fn run_refuses_to_overwrite_its_audio() {
+    let s = setup();
+    let dir = s.root.join("out-overwrite");
+    std::fs::create_dir_all(&dir).unwrap();
+    let audio = dir.join("speech.wav");
+    std::fs::copy(&s.wav, &audio).unwrap();
+    let before = std::fs::read(&audio).unwrap();
+    let o = run_into(&s.full, &audio, &dir, &["--no-video", "--blender"]);
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("also an input"), "{err}");
+    assert_eq!(std::fs::read(&audio).unwrap(), before);
+    assert!(!dir.join("timeline.json").exists());
+}
+
 /// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
 /// counted here, every figure is finite, and broken folders are one line and exit 2.
 #[test]

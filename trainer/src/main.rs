@@ -3,6 +3,7 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    gesture_trainer::output::remove_temporaries_on_interrupt();
     let cli = match gesture_trainer::cli::parse_args::<gesture_trainer::cli::Cli>("gesture-train") {
         Ok(c) => c,
         Err(code) => return code,

@@ -3,10 +3,110 @@
 //! target, so the target is either the complete new file or untouched. On any error the
 //! temporary file is removed (it is deleted when dropped unless renamed).
 //!
-//! Errors name the *target* path, never the temporary one.
+//! Errors name the *target* path, never the temporary one. Files get the usual permissions
+//! (0666 less the umask, as any program's new files), not `tempfile`'s private 0600.
+//!
+//! **Interrupts.** A temporary file is removed when dropped, which a killed process never does:
+//! [`remove_temporaries_on_interrupt`] (called first thing by both binaries) installs a Ctrl-C
+//! handler (`ctrlc`) that deletes every temporary file still being written, then exits with
+//! status 130.
+//!
+//! **Inputs are never outputs.** [`refuse_inputs`] compares an output path with every input
+//! file of the command by canonical path (the output's folder canonicalized, as the output
+//! itself may not exist yet), so `fit --out` one of its own recordings is refused before
+//! anything is written.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// Temporary files being written right now (removed on Ctrl-C).
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn track(p: &Path) {
+    if let Ok(mut v) = LIVE.lock() {
+        v.push(p.to_path_buf());
+    }
+}
+
+fn untrack(p: &Path) {
+    if let Ok(mut v) = LIVE.lock() {
+        v.retain(|x| x != p);
+    }
+}
+
+/// Installs the Ctrl-C handler that removes unfinished temporary files (see the module docs).
+/// Calling it again does nothing.
+pub fn remove_temporaries_on_interrupt() {
+    let _ = ctrlc::set_handler(|| {
+        if let Ok(v) = LIVE.lock() {
+            for p in v.iter() {
+                let _ = std::fs::remove_file(p);
+            }
+        }
+        std::process::exit(130);
+    });
+}
+
+/// A new temporary file in `dir` named `.{name}.XXXXXX.tmp`, with the usual permissions.
+fn temporary(dir: &Path, name: &std::ffi::OsStr) -> std::io::Result<tempfile::NamedTempFile> {
+    let mut prefix = std::ffi::OsString::from(".");
+    prefix.push(name);
+    prefix.push(".");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let t = b.tempfile_in(dir)?;
+    track(t.path());
+    Ok(t)
+}
+
+/// `path` made absolute and canonical as far as it exists: its folder canonicalized and its
+/// file name appended (`None` if the folder does not exist).
+pub fn canonical_target(path: &Path) -> Option<PathBuf> {
+    if let Ok(p) = path.canonicalize() {
+        return Some(p);
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    Some(dir.canonicalize().ok()?.join(path.file_name()?))
+}
+
+/// An output that is also an input.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: this output is also an input ({}); choose another output path", output.display(), input.display())]
+pub struct OverwriteError {
+    /// The output as given.
+    pub output: PathBuf,
+    /// The input it is.
+    pub input: PathBuf,
+}
+
+/// Refuses when any of `outputs` is the same file as any of `inputs` (see the module docs).
+pub fn refuse_inputs(outputs: &[&Path], inputs: &[&Path]) -> Result<(), OverwriteError> {
+    let ins: Vec<(PathBuf, &Path)> = inputs
+        .iter()
+        .filter_map(|p| Some((p.canonicalize().ok()?, *p)))
+        .collect();
+    for out in outputs {
+        let Some(c) = canonical_target(out) else {
+            continue;
+        };
+        if let Some((_, input)) = ins.iter().find(|(i, _)| *i == c) {
+            return Err(OverwriteError {
+                output: out.to_path_buf(),
+                input: input.to_path_buf(),
+            });
+        }
+    }
+    Ok(())
+}
 
 /// Writing `path` failed.
 #[derive(Debug, thiserror::Error)]
@@ -41,18 +141,19 @@ pub fn write_atomic_with(
     let name = path
         .file_name()
         .ok_or_else(|| err(std::io::Error::other("not a file name")))?;
-    let mut prefix = std::ffi::OsString::from(".");
-    prefix.push(name);
-    prefix.push(".");
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&prefix)
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(err)?;
-    write(&mut tmp).map_err(err)?;
-    tmp.as_file_mut().flush().map_err(err)?;
-    tmp.as_file().sync_all().map_err(err)?;
-    tmp.persist(path).map_err(|e| err(e.error))?;
+    let mut tmp = temporary(dir, name).map_err(err)?;
+    let tmp_path = tmp.path().to_path_buf();
+    let written = write(&mut tmp)
+        .and_then(|()| tmp.as_file_mut().flush())
+        .and_then(|()| tmp.as_file().sync_all());
+    if let Err(e) = written {
+        drop(tmp);
+        untrack(&tmp_path);
+        return Err(err(e));
+    }
+    let persisted = tmp.persist(path);
+    untrack(&tmp_path);
+    persisted.map_err(|e| err(e.error))?;
     Ok(())
 }
 
@@ -75,20 +176,32 @@ pub fn write_all_atomic(
     let mut temps = Vec::with_capacity(files.len());
     for (name, bytes) in files {
         let target = dir.join(name);
-        let mut tmp = tempfile::Builder::new()
-            .prefix(&format!(".{name}."))
-            .suffix(".tmp")
-            .tempfile_in(dir)
-            .map_err(err(&target))?;
-        tmp.as_file_mut()
+        let mut tmp = match temporary(dir, std::ffi::OsStr::new(name)) {
+            Ok(t) => t,
+            Err(e) => {
+                temps
+                    .iter()
+                    .for_each(|(t, _): &(tempfile::NamedTempFile, PathBuf)| untrack(t.path()));
+                return Err(err(&target)(e));
+            }
+        };
+        if let Err(e) = tmp
+            .as_file_mut()
             .write_all(bytes)
             .and_then(|()| tmp.as_file().sync_all())
-            .map_err(err(&target))?;
+        {
+            untrack(tmp.path());
+            temps.iter().for_each(|(t, _)| untrack(t.path()));
+            return Err(err(&target)(e));
+        }
         temps.push((tmp, target));
     }
     let mut done: Vec<PathBuf> = Vec::with_capacity(temps.len());
+    let paths: Vec<PathBuf> = temps.iter().map(|(t, _)| t.path().to_path_buf()).collect();
+    let untrack_all = || paths.iter().for_each(|p| untrack(p));
     for (tmp, target) in temps {
         if let Err(e) = tmp.persist(&target) {
+            untrack_all();
             for d in &done {
                 let _ = std::fs::remove_file(d);
             }
@@ -96,6 +209,7 @@ pub fn write_all_atomic(
         }
         done.push(target);
     }
+    untrack_all();
     Ok(done)
 }
 

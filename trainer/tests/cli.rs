@@ -177,3 +177,148 @@ fn bad_numbers_are_refused_at_parse_time_in_one_line() {
     // --help still prints and succeeds.
     assert!(run(&["fit", "--help"]).status.success());
 }
+
+fn as_refs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+fn digest(p: &std::path::Path) -> Vec<u8> {
+    std::fs::read(p).unwrap()
+}
+
+/// No output ever replaces an input: `fit --out` one of its own recordings, `pack --out` or
+/// `--report` equal to the model, a library file or each other are one line, exit 2, and every
+/// file is left as it was; an output gets the usual permissions and no temporary file stays.
+#[test]
+fn outputs_never_overwrite_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let corpus = d.join("c");
+    let o = run(&[
+        "synth",
+        "--minutes",
+        "0.2",
+        "--take-seconds",
+        "12",
+        "--seed",
+        "3",
+        "--out",
+    ]
+    .iter()
+    .copied()
+    .chain([corpus.to_str().unwrap()])
+    .collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let wav = std::fs::read_dir(&corpus)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "wav"))
+        .unwrap();
+    let bvh = wav.with_extension("bvh");
+    let (wav_before, bvh_before) = (digest(&wav), digest(&bvh));
+    let c = corpus.to_str().unwrap();
+    let refused = |args: &[&str], want: &str| {
+        let o = run(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+    };
+    let fit_args = |out: &str| -> Vec<String> {
+        [
+            "fit",
+            "--corpus",
+            c,
+            "--states",
+            "2",
+            "--clusters",
+            "2",
+            "--l2",
+            "0.01",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(["--lag-penalty", "1", "--restarts", "1", "--out", out].map(String::from))
+        .collect()
+    };
+    let a = fit_args(wav.to_str().unwrap());
+    refused(&as_refs(&a), "also an input");
+    assert_eq!(digest(&wav), wav_before);
+    // A working fit, then pack with bad outputs.
+    let model = d.join("model.json");
+    let a = fit_args(model.to_str().unwrap());
+    let o = run(&as_refs(&a));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(&model).unwrap().permissions().mode() & 0o777;
+        assert_ne!(mode & 0o044, 0, "model.json is private: {mode:o}");
+    }
+    let model_before = digest(&model);
+    let m = model.to_str().unwrap();
+    let blob = d.join("x.blob");
+    let b = blob.to_str().unwrap();
+    for (args, want) in [
+        (
+            vec!["pack", "--model", m, "--library", c, "--out", m],
+            "also an input",
+        ),
+        (
+            vec![
+                "pack",
+                "--model",
+                m,
+                "--library",
+                c,
+                "--out",
+                bvh.to_str().unwrap(),
+            ],
+            "also an input",
+        ),
+        (
+            vec![
+                "pack",
+                "--model",
+                m,
+                "--library",
+                c,
+                "--out",
+                b,
+                "--report",
+                m,
+            ],
+            "also an input",
+        ),
+        (
+            vec![
+                "pack",
+                "--model",
+                m,
+                "--library",
+                c,
+                "--out",
+                b,
+                "--report",
+                b,
+            ],
+            "same file",
+        ),
+    ] {
+        refused(&args, want);
+    }
+    assert_eq!(digest(&model), model_before);
+    assert_eq!(digest(&bvh), bvh_before);
+    assert!(!blob.exists());
+    // No temporary file anywhere.
+    for e in std::fs::read_dir(d)
+        .unwrap()
+        .chain(std::fs::read_dir(&corpus).unwrap())
+    {
+        let n = e.unwrap().file_name().into_string().unwrap();
+        assert!(
+            !n.ends_with(".tmp") && !n.ends_with(".partial"),
+            "leftover {n}"
+        );
+    }
+}

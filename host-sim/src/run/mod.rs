@@ -110,6 +110,9 @@ pub enum RunError {
         /// The path.
         path: PathBuf,
     },
+    /// An output file would replace an input.
+    #[error(transparent)]
+    Overwrite(#[from] gesture_trainer::output::OverwriteError),
     /// The simulation could not be set up (a bug: the blob was validated).
     #[error("simulation: {0}")]
     Sim(String),
@@ -146,7 +149,8 @@ impl RunError {
             | Self::Rig(_)
             | Self::RigMismatch { .. }
             | Self::Audio(_)
-            | Self::OutNotDir { .. } => 2,
+            | Self::OutNotDir { .. }
+            | Self::Overwrite(_) => 2,
             Self::Sim(_) | Self::Render { .. } | Self::Write { .. } => 1,
         }
     }
@@ -248,6 +252,19 @@ pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
     s
 }
 
+/// Every file a run may write into its folder.
+pub const OUTPUT_NAMES: [&str; 9] = [
+    "motion.bvh",
+    "timeline.json",
+    "servo.csv",
+    "preview.png",
+    "preview.gif",
+    "viewer.html",
+    "preview.mp4",
+    "speech.wav",
+    "blender.py",
+];
+
 /// Renders every output of a run (`samples`: the speech at the blob's rate, for
 /// `viewer.html`); with `video_audio`, also `preview.mp4` with that sound track.
 pub fn render(
@@ -334,6 +351,14 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         }
         .into());
     }
+    // No output may replace an input (e.g. --out the audio's folder with the audio named
+    // speech.wav, which --blender writes).
+    let outputs: Vec<PathBuf> = OUTPUT_NAMES.iter().map(|n| cfg.out.join(n)).collect();
+    let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
+    let mut inputs: Vec<&Path> = vec![&cfg.blob, &cfg.audio];
+    inputs.extend(cfg.rig.as_deref());
+    inputs.extend(cfg.bone_map.as_deref());
+    gesture_trainer::output::refuse_inputs(&outputs, &inputs).map_err(RunError::from)?;
     let bytes = read_blob(&cfg.blob)?;
     let blob = Blob::parse(&bytes).map_err(|source| RunError::Blob {
         path: cfg.blob.clone(),

@@ -34,6 +34,18 @@ pub struct FitArgs {
 /// Runs the command.
 pub fn run(a: &FitArgs) -> Result<(), CliError> {
     let start = Instant::now();
+    // The output must not be one of the recordings it is trained on.
+    let inputs: Vec<std::path::PathBuf> = crate::corpus::discover(&a.corpus)
+        .map(|takes| {
+            takes
+                .into_iter()
+                .flat_map(|t| [t.bvh, t.wav])
+                .flatten()
+                .collect()
+        })
+        .unwrap_or_default();
+    let inputs: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    crate::output::refuse_inputs(&[&a.out], &inputs)?;
     let load = a.load.options();
     let corpus = load_corpus(&a.corpus, &load)?;
     let (seqs, segs) = sequences(&corpus, a.span);

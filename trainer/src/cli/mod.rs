@@ -113,6 +113,12 @@ impl<E: std::error::Error + ExitKind> From<E> for CliError {
     }
 }
 
+impl From<crate::output::OverwriteError> for CliError {
+    fn from(e: crate::output::OverwriteError) -> Self {
+        Self::Input(e.to_string())
+    }
+}
+
 impl From<String> for CliError {
     fn from(m: String) -> Self {
         Self::Input(m)

@@ -44,6 +44,28 @@ pub struct PackArgs {
 
 /// Runs the command.
 pub fn run(a: &PackArgs) -> Result<(), CliError> {
+    // No output may be an input (the model, the rig, a library file) or the other output.
+    let mut inputs: Vec<std::path::PathBuf> = vec![a.model.clone()];
+    inputs.extend(a.rig.clone());
+    if let Ok(takes) = crate::corpus::discover(&a.library) {
+        inputs.extend(takes.into_iter().flat_map(|t| [t.bvh, t.wav]).flatten());
+    }
+    if let Some(r) = &a.report {
+        inputs.push(r.clone());
+        // The report against the inputs, the blob against the inputs and the report (a report
+        // that does not exist yet cannot be compared by canonical path: compare the targets).
+        if crate::output::canonical_target(r) == crate::output::canonical_target(&a.out) {
+            return Err(CliError::Input(format!(
+                "{}: --out and --report are the same file",
+                a.out.display()
+            )));
+        }
+    }
+    let ins: Vec<&std::path::Path> = inputs.iter().map(|p| p.as_path()).collect();
+    crate::output::refuse_inputs(&[&a.out], &ins)?;
+    if let Some(r) = &a.report {
+        crate::output::refuse_inputs(&[r], &ins[..ins.len() - 1])?;
+    }
     a.control.validate()?;
     a.device.validate()?;
     let mut opts = PackOptions {

@@ -267,62 +267,48 @@ pub enum WriteError {
     },
 }
 
-/// Writes `path` via a temporary file in the same folder and a rename, so a reader never sees
-/// a half-written file.
+/// Writes `path` through [`crate::output::write_atomic_with`] (a distinct temporary file beside
+/// it, renamed at the end, removed on error or Ctrl-C).
 fn write_atomic(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), WriteError>,
+    write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
 ) -> Result<(), WriteError> {
-    let tmp = path.with_extension(format!(
-        "{}.partial",
-        path.extension().and_then(|e| e.to_str()).unwrap_or("tmp")
-    ));
-    write(&tmp)?;
-    std::fs::rename(&tmp, path).map_err(|source| WriteError::Io {
-        path: path.to_path_buf(),
-        source,
+    crate::output::write_atomic_with(path, |t| write(t.as_file_mut())).map_err(|e| WriteError::Io {
+        path: e.path,
+        source: e.source,
     })
 }
 
 /// Writes one take as `DIR/<stem>.wav` and `DIR/<stem>.bvh`.
 pub fn write_take(take: &Take, dir: &Path) -> Result<(), WriteError> {
     let wav = dir.join(format!("{}.wav", take.stem));
-    write_atomic(&wav, |tmp| {
+    write_atomic(&wav, |f| {
         let spec = hound::WavSpec {
             channels: 1,
             sample_rate: AUDIO_RATE,
             bits_per_sample: 16,
             sample_format: hound::SampleFormat::Int,
         };
-        let wrap = |source| WriteError::Wav {
-            path: wav.clone(),
-            source,
-        };
-        let mut w = hound::WavWriter::create(tmp, spec).map_err(wrap)?;
+        let wrap = |e: hound::Error| std::io::Error::other(e.to_string());
+        let mut w = hound::WavWriter::new(std::io::BufWriter::new(f), spec).map_err(wrap)?;
         for &s in &take.audio {
             w.write_sample(s).map_err(wrap)?;
         }
         w.finalize().map_err(wrap)
     })?;
     let bvh = dir.join(format!("{}.bvh", take.stem));
-    write_atomic(&bvh, |tmp| {
-        crate::motion::write_bvh_file(&take.motion(), tmp).map_err(|source| WriteError::Io {
-            path: bvh.clone(),
-            source,
-        })
+    write_atomic(&bvh, |f| {
+        let mut w = std::io::BufWriter::new(f);
+        crate::motion::write_bvh(&take.motion(), &mut w)?;
+        std::io::Write::flush(&mut w)
     })
 }
 
 /// Writes `truth.json`.
 pub fn write_truth(truth: &Truth, dir: &Path) -> Result<(), WriteError> {
     let path = dir.join("truth.json");
-    write_atomic(&path, |tmp| {
-        let text = serde_json::to_string_pretty(truth).expect("truth serializes");
-        std::fs::write(tmp, text).map_err(|source| WriteError::Io {
-            path: path.clone(),
-            source,
-        })
-    })
+    let text = serde_json::to_string_pretty(truth).expect("truth serializes");
+    write_atomic(&path, |f| std::io::Write::write_all(f, text.as_bytes()))
 }
 
 #[cfg(test)]
