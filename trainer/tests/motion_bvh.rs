@@ -280,7 +280,22 @@ fn every_error_names_file_and_line() {
             MIXED.replace("Frame Time: 0.0333333", "Frame Time: 0"),
             27,
             |k| matches!(k, BvhErrorKind::BadFrameTime { .. }),
-            "bad.bvh:27: frame time must be a positive number of seconds, found `0`",
+            "bad.bvh:27: frame time must be between 0.001 and 1 seconds (1 to 1000 frames per \
+             second), found `0`",
+        ),
+        (
+            "huge frame time (used to exhaust memory in pack)",
+            MIXED.replace("Frame Time: 0.0333333", "Frame Time: 1e300"),
+            27,
+            |k| matches!(k, BvhErrorKind::BadFrameTime { .. }),
+            "found `1e300`",
+        ),
+        (
+            "frame time too short",
+            MIXED.replace("Frame Time: 0.0333333", "Frame Time: 0.00001"),
+            27,
+            |k| matches!(k, BvhErrorKind::BadFrameTime { .. }),
+            "found `0.00001`",
         ),
         (
             "negative frame time",
@@ -557,4 +572,24 @@ fn fk_plan_errors() {
         plan.positions(&other),
         Err(fk::FkError::SkeletonMismatch { .. })
     ));
+}
+
+/// A joint name that could not be written back as BVH (empty, padded, with a brace or a line
+/// break) is refused by the skeleton's check, so no reader (BVH, blob) can pass one on to the
+/// writer (an empty name used to give an unreadable motion.bvh).
+#[test]
+fn unwritable_joint_names_are_refused() {
+    for bad in ["", " ", " Hips", "Hips\n", "a{b"] {
+        let sk = gesture_trainer::motion::Skeleton {
+            joints: vec![gesture_trainer::motion::Joint {
+                name: bad.to_string(),
+                parent: None,
+                offset: [0.0; 3],
+                channels: vec![],
+                end_site: None,
+            }],
+        };
+        let e = sk.validate().unwrap_err().to_string();
+        assert!(e.contains("joint names must be"), "{bad:?}: {e}");
+    }
 }

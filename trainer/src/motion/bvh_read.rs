@@ -11,7 +11,7 @@
 //! - **A [`Motion`] is valid once built** (check once, then trust): joints are in depth-first
 //!   order (every parent precedes its children, and the joints of a subtree are contiguous, as
 //!   in the file), no joint lists a channel twice, offsets and all samples are finite,
-//!   `frame_time > 0`, and `data.len() == frames * channel_count`. Both [`parse_bvh`] and
+//!   `0.001 <= frame_time <= 1`, and `data.len() == frames * channel_count`. Both [`parse_bvh`] and
 //!   [`Motion::new`] enforce this, and the fields are private, so forward kinematics and the
 //!   writer can rely on it without re-checking.
 //!
@@ -29,7 +29,7 @@
 //! - Rejected with a line number: non-numeric values (a decimal comma gets a hint), NaN and
 //!   infinities (also `1e999`, which overflows to infinity), a frame line with the wrong number
 //!   of values, a `Frames:` count that disagrees with the number of frame lines, a frame time
-//!   that is not a positive finite number, unknown channel names, a file that ends early.
+//!   that is not between 0.001 and 1 s, unknown channel names, a file that ends early.
 //!
 //! ## Speed
 //!
@@ -38,6 +38,11 @@
 //! per line. A 12-minute, 75-joint take (21,600 frames x 228 channels) parses in a fraction of
 //! a second in release builds (see the `parse_speed` test).
 //!
+
+/// Shortest accepted frame time (s): 1000 frames per second.
+pub const MIN_FRAME_TIME_S: f64 = 0.001;
+/// Longest accepted frame time (s): 1 frame per second.
+pub const MAX_FRAME_TIME_S: f64 = 1.0;
 
 use std::io;
 use std::path::Path;
@@ -140,8 +145,8 @@ pub enum BvhErrorKind {
         /// What to do about it.
         advice: &'static str,
     },
-    /// `Frame Time:` is zero, negative or not finite.
-    #[error("frame time must be a positive number of seconds, found `{found}`")]
+    /// `Frame Time:` is not between 0.001 and 1 s.
+    #[error("frame time must be between 0.001 and 1 seconds (1 to 1000 frames per second), found `{found}`")]
     BadFrameTime {
         /// The token.
         found: String,
@@ -408,7 +413,9 @@ impl<'a> Parser<'a, '_> {
         let tok = self.next_or("`Time:`")?;
         let value = self.labelled_value(tok, "Time", "`Frame Time:`")?;
         let frame_time = self.number(value)?;
-        if frame_time <= 0.0 {
+        // 1 to 1000 frames per second: anything else is not a motion capture (and a huge
+        // frame time made later stages allocate without bound).
+        if !(MIN_FRAME_TIME_S..=MAX_FRAME_TIME_S).contains(&frame_time) {
             return Err(self.err(
                 value.line,
                 BvhErrorKind::BadFrameTime {

@@ -5,7 +5,7 @@
 //! **A [`Motion`] is valid once built** (check once, then trust): joints are in depth-first
 //! order (every parent precedes its children, and the joints of a subtree are contiguous, as
 //! in the file), no joint lists a channel twice, joint names are not empty and have no line
-//! breaks, offsets and all samples are finite, `frame_time > 0`, and
+//! breaks, offsets and all samples are finite, `0.001 <= frame_time <= 1`, and
 //! `data.len() == frames * channel_count`. The BVH reader ([`super::parse_bvh`]) and
 //! [`Motion::new`] enforce this, and the fields are private, so forward kinematics and the
 //! writer can rely on it without re-checking.
@@ -103,6 +103,17 @@ impl Skeleton {
                 joint: joint.name.clone(),
                 reason,
             };
+            // A BVH file names every joint on its own line: an empty name, or one with a line
+            // break or braces, could not be written back readably.
+            let name = joint.name.trim();
+            if name.is_empty()
+                || name.len() != joint.name.len()
+                || joint.name.contains(['\n', '\r', '{', '}'])
+            {
+                return Err(bad(
+                    "joint names must be non-empty, without surrounding spaces, line breaks or braces",
+                ));
+            }
             match joint.parent {
                 None => open.clear(),
                 Some(p) => {
@@ -159,7 +170,9 @@ impl Motion {
         data: Vec<f64>,
     ) -> Result<Motion, MotionError> {
         skeleton.validate()?;
-        if !(frame_time.is_finite() && frame_time > 0.0) {
+        if !(super::bvh_read::MIN_FRAME_TIME_S..=super::bvh_read::MAX_FRAME_TIME_S)
+            .contains(&frame_time)
+        {
             return Err(MotionError::BadFrameTime(frame_time));
         }
         let channels = skeleton.channel_count();
@@ -290,8 +303,10 @@ pub enum MotionError {
         /// What is wrong.
         reason: &'static str,
     },
-    /// The frame time is zero, negative or not finite.
-    #[error("frame time must be a positive number of seconds, got {0}")]
+    /// The frame time is not between 0.001 and 1 s.
+    #[error(
+        "frame time must be between 0.001 and 1 seconds (1 to 1000 frames per second), got {0}"
+    )]
     BadFrameTime(f64),
     /// `data.len()` is not `frames * channels`.
     #[error("{frames} frames x {channels} channels needs that many values, got {found}")]
