@@ -7,8 +7,10 @@
 //! CSV. Pooled metrics use all matched frames of all files together. Syllables are counted for
 //! the files listed in `cmu-arctic/prompts.tsv`.
 //!
-//! The data folder is optional (its licences keep it out of the repository): when it is
-//! absent, this prints that nothing was measured and succeeds, so tests can skip.
+//! The data folder is optional (its licences keep it out of the repository): when the default
+//! folder is absent, this prints that nothing was measured and succeeds, so tests can skip; a
+//! folder given with `--data` that does not exist or holds no referenced WAV is an error (one
+//! line, exit 2).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -349,8 +351,15 @@ pub fn to_json(r: &Report) -> Value {
 
 /// Runs the subcommand: resolve the folder, evaluate, print.
 pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(), SimError> {
+    let given = |reason: &str| -> SimError {
+        SimError::Read {
+            path: data.map(Path::to_path_buf).unwrap_or_default(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, reason.to_string()),
+        }
+    };
     let dir = match resolve_data_dir(data) {
         DataDir::Found(d) => d,
+        DataDir::Missing(_) if data.is_some() => return Err(given("no such data folder")),
         DataDir::Missing(tried) => {
             let tried: Vec<String> = tried.iter().map(|p| p.display().to_string()).collect();
             let reason = format!("no data folder (tried {})", tried.join(", "));
@@ -364,6 +373,9 @@ pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(
         }
     };
     let report = evaluate(&dir)?;
+    if report.files.is_empty() && data.is_some() {
+        return Err(given("no WAV file here has a reference in reference/praat/"));
+    }
     if report.files.is_empty() {
         let reason = format!(
             "no WAV file under {} has a reference in reference/praat/",

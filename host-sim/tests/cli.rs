@@ -200,17 +200,25 @@ fn closed_stdout_does_not_panic() {
     assert_eq!(status.code(), Some(0), "stderr: {err}");
 }
 
+/// A data folder given with `--data` that does not exist, or holds no referenced recording, is
+/// one line naming it and exit 2 (it used to print "nothing was measured" and succeed); only
+/// the default folder may be absent quietly, so that tests can skip.
 #[test]
-fn eval_without_data_measures_nothing_and_succeeds() {
+fn eval_with_a_missing_data_folder_is_an_error() {
     let dir = tempfile::tempdir().unwrap();
     let absent = dir.path().join("no-data-here");
-    let out = run(&["eval-prosody", "--data", absent.to_str().unwrap()]);
-    assert!(out.status.success());
-    assert!(text(&out.stdout).contains("nothing was measured"));
-    let out = run(&["eval-prosody", "--json", "--data", absent.to_str().unwrap()]);
-    assert!(out.status.success());
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["measured"], false);
+    for args in [
+        vec!["eval-prosody", "--data", absent.to_str().unwrap()],
+        vec!["eval-prosody", "--json", "--data", absent.to_str().unwrap()],
+        vec!["eval-prosody", "--data", dir.path().to_str().unwrap()],
+    ] {
+        let out = run(&args);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(args.last().unwrap()), "{err}");
+        assert!(out.stdout.is_empty());
+    }
 }
 
 /// On the shared recordings (skipped when they are absent): the report covers every reference,

@@ -382,3 +382,31 @@ fn unsupported_sample_formats() {
         assert!(e.to_string().contains(text), "{e}");
     }
 }
+
+/// A file with more than two channels, or with no samples at all, is refused in one line
+/// naming the file (both used to load silently: six channels averaged, or an empty signal).
+#[test]
+fn six_channels_and_empty_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let spec = WavSpec {
+        channels: 6,
+        sample_rate: 16_000,
+        bits_per_sample: 16,
+        sample_format: SampleFormat::Int,
+    };
+    let six = dir.path().join("surround.wav");
+    let mut w = WavWriter::create(&six, spec).unwrap();
+    for _ in 0..6 * 1600 {
+        w.write_sample(100i16).unwrap();
+    }
+    w.finalize().unwrap();
+    let e = load_wav(&six).unwrap_err();
+    assert!(matches!(e, AudioError::UnsupportedChannels { channels: 6, .. }), "{e}");
+    assert!(e.to_string().starts_with(&format!("{}: 6 channels", six.display())));
+    let empty = dir.path().join("empty.wav");
+    let w = WavWriter::create(&empty, WavSpec { channels: 1, ..spec }).unwrap();
+    w.finalize().unwrap();
+    let e = load_wav(&empty).unwrap_err();
+    assert!(matches!(e, AudioError::Empty { .. }), "{e}");
+    assert_eq!(e.to_string().lines().count(), 1);
+}

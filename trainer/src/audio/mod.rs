@@ -3,8 +3,9 @@
 //! [`load_wav`] reads any common WAV file and returns mono `i16` samples at the front-end rate;
 //! [`convert`] does the same for samples already in memory (`f32` mono at some rate).
 //!
-//! **Accepted input.** 8 to 48 kHz; any number of channels (mixed to mono by averaging, so a
-//! stereo file with the same signal on both sides loads as that signal); integer PCM of 8, 16,
+//! **Accepted input.** 8 to 48 kHz; mono or stereo (stereo mixed to mono by averaging, so a
+//! stereo file with the same signal on both sides loads as that signal; more channels are
+//! refused rather than guessed at, and so is a file without samples); integer PCM of 8, 16,
 //! 24 (3- or 4-byte containers) or 32 bits, or 32-bit IEEE float; plain `WAVE_FORMAT_PCM` /
 //! `WAVE_FORMAT_IEEE_FLOAT` headers or `WAVE_FORMAT_EXTENSIBLE`. Everything else is refused with
 //! an [`AudioError`] whose `Display` is one line, `<file>: <reason>`.
@@ -41,6 +42,9 @@ mod resample;
 
 use resample::resample;
 pub use resample::StreamResampler;
+
+/// Most channels a loaded file may have (stereo).
+pub const MAX_CHANNELS: usize = 2;
 
 /// Lowest accepted file (and target) sample rate in Hz.
 pub const MIN_RATE_HZ: u32 = 8_000;
@@ -176,6 +180,23 @@ pub enum AudioError {
         /// Its rate.
         rate_hz: u32,
     },
+    /// More channels than a speech recording has.
+    #[error(
+        "{}: {channels} channels: give a mono or stereo recording (e.g. `ffmpeg -i in.wav -ac 1 out.wav`)",
+        path.display()
+    )]
+    UnsupportedChannels {
+        /// The file.
+        path: PathBuf,
+        /// Its channel count.
+        channels: u16,
+    },
+    /// The file holds no audio at all.
+    #[error("{}: no audio samples (the data chunk is empty)", path.display())]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
     /// Conversion to the target rate failed.
     #[error("{}: {source}", path.display())]
     Convert {
@@ -197,6 +218,8 @@ impl AudioError {
             | Self::Malformed { path, .. }
             | Self::UnsupportedFormat { path, .. }
             | Self::UnsupportedRate { path, .. }
+            | Self::UnsupportedChannels { path, .. }
+            | Self::Empty { path }
             | Self::Convert { path, .. } => path,
         }
     }
@@ -307,7 +330,18 @@ fn decode_mono(bytes: &[u8], path: &Path) -> Result<(Vec<f32>, SourceFormat), Au
         });
     }
     let channels = spec.channels as usize; // hound refuses 0 channels
+    if channels > MAX_CHANNELS {
+        return Err(AudioError::UnsupportedChannels {
+            path: path.to_owned(),
+            channels: spec.channels,
+        });
+    }
     let frames = reader.duration() as usize;
+    if frames == 0 {
+        return Err(AudioError::Empty {
+            path: path.to_owned(),
+        });
+    }
     let source = SourceFormat {
         rate_hz: spec.sample_rate,
         channels: spec.channels,
