@@ -374,7 +374,9 @@ pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(
     };
     let report = evaluate(&dir)?;
     if report.files.is_empty() && data.is_some() {
-        return Err(given("no WAV file here has a reference in reference/praat/"));
+        return Err(given(
+            "no WAV file here has a reference in reference/praat/",
+        ));
     }
     if report.files.is_empty() {
         let reason = format!(

@@ -441,6 +441,18 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         let hold = at_beat && !fresh && !self.ticks_reach_ms(self.holding + 1, t.beat_hold_ms);
         self.holding = if hold { self.holding + 1 } else { 0 };
         let played = self.player.tick_advancing(self.lib, &mut self.pose, !hold);
+        // What leaves the controller is within the rig's limits and finite, whatever the
+        // frames and the blend made of it (a board without the rig's own clamp must not drive
+        // a servo into its stop).
+        let channels = self.lib.channels().min(MAX_CHANNELS);
+        for (ch, v) in self.pose[..channels].iter_mut().enumerate() {
+            let (lo, hi, neutral) = self.lib.limits(ch);
+            *v = if v.is_finite() {
+                v.max(lo).min(hi)
+            } else {
+                neutral
+            };
+        }
         let tick = self.ticks;
         self.ticks += 1;
         if self.ticks == 1 {

@@ -68,6 +68,10 @@ pub trait LibraryFrames {
     fn group(&self, _g: usize) -> (usize, [u8; 3]) {
         (usize::MAX, [0, 1, 2])
     }
+    /// Channel `ch`'s limits and neutral angle (degrees): what a pose may hand the rig.
+    fn limits(&self, _ch: usize) -> (f32, f32, f32) {
+        (f32::MIN, f32::MAX, 0.0)
+    }
 }
 
 /// Segment playback with inertialized cuts.

@@ -401,10 +401,22 @@ fn six_channels_and_empty_files_are_refused() {
     }
     w.finalize().unwrap();
     let e = load_wav(&six).unwrap_err();
-    assert!(matches!(e, AudioError::UnsupportedChannels { channels: 6, .. }), "{e}");
-    assert!(e.to_string().starts_with(&format!("{}: 6 channels", six.display())));
+    assert!(
+        matches!(e, AudioError::UnsupportedChannels { channels: 6, .. }),
+        "{e}"
+    );
+    assert!(e
+        .to_string()
+        .starts_with(&format!("{}: 6 channels", six.display())));
     let empty = dir.path().join("empty.wav");
-    let w = WavWriter::create(&empty, WavSpec { channels: 1, ..spec }).unwrap();
+    let w = WavWriter::create(
+        &empty,
+        WavSpec {
+            channels: 1,
+            ..spec
+        },
+    )
+    .unwrap();
     w.finalize().unwrap();
     let e = load_wav(&empty).unwrap_err();
     assert!(matches!(e, AudioError::Empty { .. }), "{e}");

@@ -68,4 +68,9 @@ impl LibraryFrames for Blob<'_> {
     fn group(&self, g: usize) -> (usize, [u8; 3]) {
         Blob::group(self, g).unwrap_or((usize::MAX, [0, 1, 2]))
     }
+    fn limits(&self, ch: usize) -> (f32, f32, f32) {
+        self.calibration(ch).map_or((f32::MIN, f32::MAX, 0.0), |c| {
+            (c.min_deg, c.max_deg, c.neutral_deg)
+        })
+    }
 }

@@ -243,16 +243,17 @@ pub struct Rig {
     pub channels: Vec<RigChannel>,
 }
 
-/// Calibration of the channels of [`Rig::full_skeleton`]: neutral 0, limits +-180 deg, direction
-/// +1, slew effectively unlimited. The pulse fields (1500 us, 5 us/deg) only satisfy
-/// [`ChannelCal::validate`]; they mean nothing for BVH output.
+/// Calibration of the channels of [`Rig::full_skeleton`]: neutral 0, limits +-360 deg (a
+/// capture's Euler angles may pass +-180; the controller clamps poses to these limits),
+/// direction +1, slew effectively unlimited. The pulse fields (1500 us, 2.5 us/deg) only
+/// satisfy [`ChannelCal::validate`]; they mean nothing for BVH output.
 pub const WIDE_CAL: ChannelCal = ChannelCal {
     neutral_deg: 0.0,
-    min_deg: -180.0,
-    max_deg: 180.0,
+    min_deg: -360.0,
+    max_deg: 360.0,
     direction: 1.0,
     pulse_neutral_us: 1500.0,
-    us_per_deg: 5.0,
+    us_per_deg: 2.5,
     max_slew_deg_per_s: 1.0e6,
 };
 
