@@ -14,9 +14,17 @@
 //! starts at `initial_peak_db` and decays slowly (1 dB per second), so it adapts to the speaker
 //! and microphone level within a few syllables.
 //!
+//! **Long sounds.** A syllable that reaches [`MAX_STEP_FRAMES`] (1 s) without a trough is closed
+//! there and a new one starts at once: stationary loud noise (a fan, music, a held vowel) then
+//! gives a step a second instead of one step when it stops, so the belief keeps updating and
+//! decisions keep coming. Speech syllables are far shorter, so speech is unaffected.
+//!
 //! Per step: first frame, end frame (exclusive), mean F0 over its voiced frames (or unvoiced when
 //! none), mean intensity. Invariants: O(1) memory and time per frame, no allocation, no panics,
 //! all outputs finite.
+
+/// Longest step (frames of 10 ms): a syllable this long is closed and the next one starts.
+pub const MAX_STEP_FRAMES: u32 = 100;
 
 /// Tunables of the syllable detector.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -236,6 +244,20 @@ impl SyllableDetector {
         }
         self.silent_run = 0;
         self.pause = Acc::default();
+        if self.phase != Phase::Silence && k - self.seg_start >= MAX_STEP_FRAMES {
+            // A second of sound without a trough: close it here (see the module docs).
+            self.a.merge(&self.b);
+            let step = self.a.step(StepKind::Syllable, self.seg_start, k);
+            self.phase = Phase::Rising;
+            self.seg_start = k;
+            self.onset = Some(k);
+            self.start_level = self.threshold_db();
+            self.max_db = db;
+            self.a = Acc::default();
+            self.b = Acc::default();
+            self.a.add(f0, db);
+            return Some(step);
+        }
         match self.phase {
             Phase::Silence => {
                 self.phase = Phase::Rising;
@@ -364,6 +386,32 @@ mod tests {
     }
 
     /// Three humps of 8 frames with 6 dB dips, then silence long enough for two pause steps.
+    #[test]
+    fn a_minute_of_steady_loud_sound_gives_a_step_a_second() {
+        let mut d = SyllableDetector::new(SyllableParams::DEFAULT);
+        let mut steps = alloc_free_steps();
+        for k in 0..6000u32 {
+            if let Some(s) = d.push(k, Some(200.0), 75.0) {
+                steps.push(s).unwrap();
+            }
+        }
+        // 60 s: 59 complete one-second steps (the 60th is still open).
+        assert_eq!(steps.len(), 59);
+        for (i, s) in steps.iter().enumerate() {
+            assert_eq!(s.kind, StepKind::Syllable);
+            assert_eq!(
+                (s.start_frame, s.end_frame),
+                (100 * i as u32, 100 * (i as u32 + 1))
+            );
+            assert!((s.intensity_db - 75.0).abs() < 1e-4);
+        }
+        assert_eq!(d.flush(6000).map(|s| s.end_frame), Some(6000));
+    }
+
+    fn alloc_free_steps() -> heapless::Vec<Step, 64> {
+        heapless::Vec::new()
+    }
+
     #[test]
     fn humps_become_syllables_then_pauses() {
         let mut c = [20.0f32; 24 + 60];
