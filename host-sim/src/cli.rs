@@ -119,6 +119,19 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Hours of hostile generated audio through a blob's device loop: tick drift, memory,
+    /// limit violations (exit 1 when a check fails).
+    Soak {
+        /// Policy blob.
+        #[arg(long, value_name = "BLOB")]
+        blob: PathBuf,
+        /// Hours of audio.
+        #[arg(long, default_value_t = 1.0, value_parser = parse_hours)]
+        hours: f64,
+        /// Seed of the generated audio.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// List the audio input devices.
     Devices,
     /// Run a policy blob on the microphone, printing decisions and the belief.
@@ -147,6 +160,15 @@ fn parse_chunk_ms(s: &str) -> Result<f64, String> {
         Ok(v)
     } else {
         Err("must be between 0.1 and 1000".into())
+    }
+}
+
+fn parse_hours(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v > 0.0 && v <= 1000.0 {
+        Ok(v)
+    } else {
+        Err("must be more than 0 and at most 1000".into())
     }
 }
 
@@ -194,6 +216,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             out,
         ),
         Command::Devices => Ok(live::devices(out)?),
+        Command::Soak { blob, hours, seed } => crate::soak::run(blob, *hours, *seed, out),
         Command::Metrics { dir, mocap, json } => {
             crate::metrics_cmd::run(dir, mocap.as_ref(), *json, out)
         }

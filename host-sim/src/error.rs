@@ -52,6 +52,9 @@ pub enum SimError {
     /// `metrics` could not read or measure a run folder.
     #[error("{0}")]
     Metrics(String),
+    /// `soak` found a failure.
+    #[error("{0}")]
+    Soak(String),
     /// `--vmc` could not start or send.
     #[error(transparent)]
     Vmc(#[from] crate::vmc::VmcError),
@@ -73,6 +76,7 @@ impl SimError {
             Self::Live(e) => e.exit_code(),
             Self::Demo(e) => e.exit_code(),
             Self::Metrics(_) => 2,
+            Self::Soak(_) => 1,
             Self::Vmc(crate::vmc::VmcError::Send(_)) => 1,
             Self::Vmc(_) => 2,
         }

@@ -36,4 +36,5 @@ pub mod metrics_cmd;
 pub mod prosody_cmd;
 pub mod run;
 pub mod servo;
+pub mod soak;
 pub mod vmc;

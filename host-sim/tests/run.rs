@@ -571,6 +571,36 @@ fn run_refuses_to_overwrite_its_audio() {
     assert!(!dir.join("timeline.json").exists());
 }
 
+/// `soak`: twelve minutes of hostile generated audio through the puppet's device loop: no
+/// drift, no pose or duty cycle out of its limits, steps all along, memory flat.
+#[test]
+fn soak_finds_no_violation_drift_or_growth() {
+    let s = setup();
+    let o = sim(&[
+        "soak",
+        "--blob",
+        s.puppet.to_str().unwrap(),
+        "--hours",
+        "0.2",
+    ]);
+    let stdout = text(&o.stdout);
+    assert!(o.status.success(), "{stdout}{}", text(&o.stderr));
+    assert!(
+        stdout.contains("limit violations: 0 poses, 0 duty cycles"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("soak passed"), "{stdout}");
+    let r = host_sim::soak::soak(
+        &Blob::parse(&std::fs::read(&s.puppet).unwrap()).unwrap(),
+        0.1,
+        3,
+    )
+    .unwrap();
+    assert!(r.ok(), "{r:?}");
+    assert!((r.audio_s - 360.0).abs() < 1e-9, "{r:?}");
+    assert!(r.steps > 360 && r.decisions > 10, "{r:?}");
+}
+
 /// `gesture-sim metrics` on a run folder: the variety figures agree with the timeline's entries
 /// counted here, every figure is finite, and broken folders are one line and exit 2.
 #[test]
