@@ -84,7 +84,11 @@ fn minute(block: u64, rate: u32, rng: &mut ChaCha8Rng) -> Vec<i16> {
     match block % 6 {
         // Speech-like: 4 syllables a second with pitch and level varying, short pauses.
         0 | 3 => {
-            let level = if block.is_multiple_of(6) { 12_000.0 } else { 1_500.0 };
+            let level = if block.is_multiple_of(6) {
+                12_000.0
+            } else {
+                1_500.0
+            };
             (0..n)
                 .map(|i| {
                     let s = t(i);

@@ -6,7 +6,7 @@ use gesture_runtime::controller::DecisionTiming;
 use super::CliError;
 
 /// A finite number in `lo..=hi`, or the reason it is not (clap prints it with the flag).
-fn bounded(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
+pub fn bounded(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
     let v: f64 = s
         .trim()
         .parse()
@@ -29,11 +29,6 @@ pub fn count(s: &str, lo: usize, hi: usize) -> Result<usize, String> {
     } else {
         Err(format!("must be from {lo} to {hi}"))
     }
-}
-
-/// [`bounded`] for other command files.
-pub fn bounded_pub(s: &str, lo: f64, hi: f64) -> Result<f64, String> {
-    bounded(s, lo, hi)
 }
 
 /// A weight or cost: finite, 0 to 1e6.

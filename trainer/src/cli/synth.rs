@@ -11,13 +11,13 @@ use crate::synth::{write_corpus, SynthParams};
 #[derive(Debug, clap::Args)]
 pub struct SynthArgs {
     /// Total length in minutes.
-    #[arg(long, default_value_t = 2.0, value_parser = |s: &str| super::args::bounded_pub(s, 0.01, 600.0))]
+    #[arg(long, default_value_t = 2.0, value_parser = |s: &str| super::args::bounded(s, 0.01, 600.0))]
     pub minutes: f64,
     /// Seed (the same seed gives the same corpus, byte for byte).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Length of each take in seconds.
-    #[arg(long, default_value_t = 60.0, value_parser = |s: &str| super::args::bounded_pub(s, 5.0, 3600.0))]
+    #[arg(long, default_value_t = 60.0, value_parser = |s: &str| super::args::bounded(s, 5.0, 3600.0))]
     pub take_seconds: f64,
     /// Output folder (created if missing).
     #[arg(long)]
