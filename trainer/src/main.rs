@@ -3,7 +3,11 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    gesture_trainer::output::remove_temporaries_on_interrupt();
+    // Ctrl-C: no half-written temporary file stays behind (gesture_trainer::output).
+    let _ = ctrlc::set_handler(|| {
+        gesture_trainer::output::remove_temporaries();
+        std::process::exit(130);
+    });
     let cli = match gesture_trainer::cli::parse_args::<gesture_trainer::cli::Cli>("gesture-train") {
         Ok(c) => c,
         Err(code) => return code,

@@ -7,8 +7,8 @@
 //! (0666 less the umask, as any program's new files), not `tempfile`'s private 0600.
 //!
 //! **Interrupts.** A temporary file is removed when dropped, which a killed process never does:
-//! [`remove_temporaries_on_interrupt`] (called first thing by both binaries) installs a Ctrl-C
-//! handler (`ctrlc`) that deletes every temporary file still being written, then exits with
+//! both binaries install a Ctrl-C handler (`ctrlc`) in `main` that calls
+//! [`remove_temporaries`] (every temporary file still being written is deleted), then exits with
 //! status 130.
 //!
 //! **Inputs are never outputs.** [`refuse_inputs`] compares an output path with every input
@@ -35,17 +35,14 @@ fn untrack(p: &Path) {
     }
 }
 
-/// Installs the Ctrl-C handler that removes unfinished temporary files (see the module docs).
-/// Calling it again does nothing.
-pub fn remove_temporaries_on_interrupt() {
-    let _ = ctrlc::set_handler(|| {
-        if let Ok(v) = LIVE.lock() {
-            for p in v.iter() {
-                let _ = std::fs::remove_file(p);
-            }
+/// Removes every temporary file still being written (for an interrupt handler: see the module
+/// docs).
+pub fn remove_temporaries() {
+    if let Ok(v) = LIVE.lock() {
+        for p in v.iter() {
+            let _ = std::fs::remove_file(p);
         }
-        std::process::exit(130);
-    });
+    }
 }
 
 /// A new temporary file in `dir` named `.{name}.XXXXXX.tmp`, with the usual permissions.
