@@ -98,6 +98,10 @@ pub struct ControlArgs {
     /// Added to the cost of leaving a segment at an interruption frame.
     #[arg(long, default_value_t = crate::control::costs::CostParams::default().interruption_penalty, value_parser = weight)]
     pub interruption_penalty: f64,
+    /// Fewest successors kept per exit point after exact pruning (the next best by expected
+    /// cost are added: they give the variety costs something to choose from).
+    #[arg(long, default_value_t = crate::control::prune::MIN_SUCCESSORS, value_parser = |s: &str| count(s, 1, 4096))]
+    pub min_successors: usize,
 }
 
 impl ControlArgs {
@@ -107,6 +111,7 @@ impl ControlArgs {
         p.cost.transition_weight = self.transition_weight;
         p.cost.interruption_penalty = self.interruption_penalty;
         p.cost.junction_weight = self.junction_weight;
+        p.min_successors = Some(self.min_successors);
         p
     }
 

@@ -19,7 +19,7 @@ use rand_chacha::ChaCha8Rng;
 use super::costs::{psi, successor_costs, CostParams, Signatures};
 use super::library::Library;
 use super::mdp::{solve, transition_matrix, Action, MdpParams, Policy};
-use super::prune::{keep_best, prune};
+use super::prune::{keep_best, pad, prune};
 use crate::inference::model::InferenceModel;
 
 /// Settings of the control layer.
@@ -31,6 +31,9 @@ pub struct ControlParams {
     pub mdp: MdpParams,
     /// Most successors kept per exit point (`None`: all non-dominated).
     pub max_successors: Option<usize>,
+    /// Fewest successors kept per exit point (padding, see `prune`; `None`:
+    /// [`super::prune::MIN_SUCCESSORS`]).
+    pub min_successors: Option<usize>,
 }
 
 /// Timings of the stages (s).
@@ -80,7 +83,10 @@ pub fn build(model: &InferenceModel, lib: &Library, params: &ControlParams) -> C
     let p = transition_matrix(&model.crf.trans, model.states());
     let policy = solve(lib, &psi, succ, &p, &params.mdp);
     let t2 = Instant::now();
-    let pruned = prune(&policy);
+    let min = params
+        .min_successors
+        .unwrap_or(super::prune::MIN_SUCCESSORS);
+    let pruned = pad(&policy, &prune(&policy), &model.state_prior, min);
     let kept = match params.max_successors {
         Some(k) => keep_best(&policy, &pruned, &model.state_prior, k),
         None => pruned.clone(),

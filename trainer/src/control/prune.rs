@@ -7,6 +7,13 @@
 //! ones kept so far (a dominator always has a smaller total, and domination is transitive).
 //! Identical vectors keep the lowest index.
 //!
+//! Exact pruning can leave an exit with one or two successors when the model has few states (a
+//! belief over two states has few corners), and then the variety costs of the runtime have
+//! nothing to choose from: the controller loops. So every exit keeps at least
+//! [`MIN_SUCCESSORS`] successors ([`pad`]): the survivors plus the next best by expected cost
+//! under the state prior. The padding never changes the pure policy's choice (the added
+//! candidates are dominated), so it costs no regret, only blob bytes.
+//!
 //! Then, if the blob must fit a budget, only the best `k` survivors per exit are kept (by cost
 //! under the state prior); that is lossy, and the pack report measures its regret.
 
@@ -44,6 +51,31 @@ pub fn prune(policy: &Policy) -> Vec<Vec<usize>> {
             }
             front.sort_unstable();
             front
+        })
+        .collect()
+}
+
+/// Fewest successors an exit keeps by default (see the module docs).
+pub const MIN_SUCCESSORS: usize = 12;
+
+/// `kept` with every exit padded to at least `min` successors (fewer if there are fewer
+/// segments): the next best by expected cost under `prior`. Sorted by segment index.
+pub fn pad(policy: &Policy, kept: &[Vec<usize>], prior: &[f64], min: usize) -> Vec<Vec<usize>> {
+    kept.iter()
+        .enumerate()
+        .map(|(e, list)| {
+            let mut out = list.clone();
+            if out.len() < min {
+                let mut rest: Vec<(f64, usize)> = (0..policy.u.len())
+                    .filter(|c| !list.contains(c))
+                    .map(|c| (policy.cost(e, super::mdp::Action::Enter(c), prior), c))
+                    .filter(|(v, _)| v.is_finite())
+                    .collect();
+                rest.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                out.extend(rest.into_iter().take(min - out.len()).map(|(_, c)| c));
+                out.sort_unstable();
+            }
+            out
         })
         .collect()
 }
