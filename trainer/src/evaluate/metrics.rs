@@ -26,7 +26,8 @@
 //!   frame by frame, between the mean hand speed smoothed over 1/6 s and the intensity (dB) of
 //!   the syllable or pause being spoken (each step's mean intensity over its span, floored at
 //!   [`COUPLING_FLOOR_DB`]). On the shared ZeroEGGS captures, with their own speech, the
-//!   coupling is 0.52 and 0.43 (0.0 and -0.19 with the motion moved by a third of the take),
+//!   coupling is 0.53 and 0.64 (9-joint take 90-121 s, 067 40-50 s; the motion moved by a third
+//!   of the take correlates -0.19 and +0.01 with the 10 ms intensity),
 //!   while beat alignment scores no better than its chance level (lift -0.02 and +0.01): people
 //!   move their hands faster while they speak louder, and syllable onsets are so dense (3-4 per
 //!   second) that any motion's speed minima fall near one. So the coupling is the figure that
