@@ -22,6 +22,9 @@
 //! - [`error`]: [`error::SimError`], the error of every command, and its exit status.
 //! - [`demo`]: `gesture-sim demo`: synth, fit, pack, a new utterance and `run`, in one command.
 //! - [`servo`]: virtual PWM pins under the runtime's `ServoRig`.
+//! - [`soak`]: `gesture-sim soak`: hours of hostile audio through a blob's device loop (drift,
+//!   limits, memory).
+//! - [`vmc`]: the played poses to avatar apps over the VMC protocol (OSC over UDP).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

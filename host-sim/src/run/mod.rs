@@ -18,7 +18,11 @@
 //! - `timeline.json`: steps, beliefs, decisions and detection latencies ([`timeline`]);
 //! - `servo.csv`: `tick,time_s,<channel>...`, the duty cycle of every channel at every tick,
 //!   as written by the runtime's `ServoRig` to virtual 16-bit PWM pins ([`crate::servo`]);
-//! - `preview.png` and `preview.gif` ([`preview`]).
+//! - `preview.png` and `preview.gif` ([`preview`]);
+//! - `viewer.html`, a self-contained page that plays the skeleton with the speech ([`viewer`]);
+//! - `preview.mp4`, the run as a video with the speech, through `ffmpeg` ([`video`]);
+//! - with `--blender`, `blender.py` and `speech.wav` ([`blender`]);
+//! - with `--vmc HOST:PORT`, the poses streamed to an avatar app ([`crate::vmc`]).
 //!
 //! The summary on stdout gives the files, the audio duration, the decisions, the median and
 //! maximum syllable detection latency and the simulation speed as a multiple of real time
