@@ -60,7 +60,12 @@ pub fn run(a: &FitArgs) -> Result<(), CliError> {
     // The model records the front end its features came from.
     cfg.prosody = load.prosody;
     cfg.sample_rate_hz = load.prosody.sample_rate_hz;
-    let (model, report) = fit(&seqs, &segs, &cfg, &|line| eprintln!("{line}"))?;
+    // A spinner while it works (terminal only); the stage lines print above it.
+    let sp = crate::progress::spinner("fit: model selection and training");
+    let (model, report) = fit(&seqs, &segs, &cfg, &|line| {
+        sp.suspend(|| eprintln!("{line}"))
+    })?;
+    sp.finish_and_clear();
     model.save(&a.out)?;
     if let Some(sel) = &report.selection {
         outln!("{}", sel.to_string().trim_end())?;
