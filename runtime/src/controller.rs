@@ -21,12 +21,20 @@
 //! decides at every exit point as soon as it is reached (the paper's controller). Onsets come
 //! from the front-end ([`Event::Onset`]).
 //!
+//! **Beat holds** (`beat_hold_ms`, 0 by default): at a motion beat of the library (a hands'
+//! speed minimum) the playback may hold, for at most that long, until a syllable onset.
+//!
 //! **Variety.** Every segment entry goes into a fixed-capacity history, from which each
 //! decision charges recently entered and much-used candidates ([`Variety`], see
 //! [`crate::policy`]). Cuts are inertialized by the player ([`crate::player`]).
 //!
+//! **Poses within the rig's limits.** Every pose is clamped to its channels' calibrated limits
+//! (a non-finite value becomes the neutral angle) before it leaves the controller, whatever
+//! the frames and the blends made of it, so a board that writes poses to its servos without
+//! the rig's own clamp cannot drive one into its stop.
+//!
 //! Memory is fixed: the front-end (about 9 KiB), a belief, the player, the history and a few
-//! counters. Nothing allocates or panics; poses are finite.
+//! counters. Nothing allocates or panics; poses are finite and within the limits.
 //!
 //! Building: [`Controller::new`] returns the controller (about 15 KiB) by value, which the
 //! compiler copies through stack temporaries on its way; [`Controller::new_in`] builds the same
