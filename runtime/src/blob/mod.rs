@@ -12,7 +12,7 @@
 //! `docs/blob-format.md` is the normative description: field meanings and units, the postcard
 //! encoding, every validation rule and the error it gives, and the versioning policy. This
 //! module is the format's only implementation: the reader below and, behind the `encode`
-//! feature (host tools), the writer in [`encode`](mod@encode), side by side.
+//! feature (host tools), the writer in `encode`, side by side.
 //!
 //! - `header`: magic, version, flags, length, CRC ([`Header`]);
 //! - `payload`: the wire structs, one per section ([`Payload`]);
