@@ -11,8 +11,11 @@
 //!
 //! **Decisions on syllable onsets** ([`DecisionTiming`]). By default, decisions are timed
 //! against the speech, so that new gestures start with syllables: an interruption exit is only
-//! decided at when a syllable onset was detected within the last `onset_window_ms` (otherwise
-//! the segment plays on, as if the policy had chosen to continue), and at a segment's end the
+//! decided at on a syllable onset detected within the last `onset_window_ms` or within
+//! `max_wait_ms` after its frame, the segment playing on meanwhile (without one, and once the
+//! segment's next exit point comes, it plays on as if the policy had chosen to continue; a
+//! long segment is so left on the speech rather than only if an onset happens to fall on one
+//! of its few interruption frames), and at a segment's end the
 //! controller waits for an onset, for at most `max_wait_ms`, before deciding. **The body never
 //! stops while it waits**: the player runs on into the segment's recorded successor (the
 //! frames that followed it in the capture); choosing that successor then simply continues it,
@@ -209,7 +212,8 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     holding: u64,
     /// Tick at which the last onset was detected (the tick due next when it arrived).
     last_onset: Option<u64>,
-    /// The end exit the controller is waiting at for an onset, running on meanwhile.
+    /// The exit the controller is waiting at for an onset: an end exit (running on into the
+    /// recorded successor meanwhile) or an interruption exit (playing on in the segment).
     waiting: Option<usize>,
     /// Ticks waited at it.
     waited: u64,
@@ -481,6 +485,33 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                 .last_onset
                 .is_some_and(|o| !self.ticks_reach_ms(tick.saturating_sub(o), t.onset_window_ms));
         if let Some(e) = self.waiting {
+            if !self.tables.exit_is_end(e) {
+                // Past an interruption frame, armed for an onset: decide on one that comes
+                // before the wait runs out or the segment's next exit point is reached;
+                // otherwise play on, as if the policy had chosen to continue.
+                let next_frame = if e + 1 < self.tables.exit_count() {
+                    self.tables.exit_frame(e + 1)
+                } else {
+                    usize::MAX
+                };
+                if fresh {
+                    self.waiting = None;
+                    self.waited = 0;
+                    self.decide(e, tick, sink);
+                } else if self.ticks_reach_ms(self.waited, t.max_wait_ms)
+                    || self.player.segment() != segment
+                    || played + 1 >= next_frame
+                {
+                    self.waiting = None;
+                    self.waited = 0;
+                    if e + 1 < self.tables.exit_count() {
+                        self.exit = e + 1;
+                    }
+                } else {
+                    self.waited += 1;
+                }
+                return;
+            }
             // Running on into the successor while waiting for an onset.
             if fresh
                 || self.ticks_reach_ms(self.waited, t.max_wait_ms)
@@ -500,8 +531,12 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         }
         if !fresh {
             if !self.tables.exit_is_end(e) {
-                // No onset now: play on past this interruption frame.
-                if e + 1 < self.tables.exit_count() {
+                // No onset now: play on past this interruption frame, armed for an onset
+                // within `max_wait_ms` (see above).
+                if t.max_wait_ms > 0 {
+                    self.waiting = Some(e);
+                    self.waited = 1;
+                } else if e + 1 < self.tables.exit_count() {
                     self.exit = e + 1;
                 }
                 return;

@@ -18,8 +18,11 @@
 //! - **usage**: `usage_cost * share` where `share` is the candidate's share of the frames
 //!   played in the last `usage` window (no segment should dominate the minute).
 //!
-//! Both are added to the candidates' costs (never to continuing: playing on is not a repeat);
-//! the value tables are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
+//! Both are added to the candidates' costs. Continuing the current segment at an interruption
+//! exit is charged its usage only (playing on is not a repeat, but a long segment that plays
+//! on at every interruption exit is what comes to dominate the minute: on the 9-joint
+//! ZeroEGGS library a 9-second segment took a third of 50 s of new speech); the value tables
+//! are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
 //! cost of variety against the pure policy (its regret) is measured by
 //! `gesture-train eval-motion`. All arithmetic is on integer ticks and the same `f32`
 //! operations on host and device, so both choose alike.
@@ -121,6 +124,7 @@ pub type History = HistoryBuffer<Visit, HISTORY>;
 pub struct Penalties {
     segment: [u16; HISTORY],
     cost: [f32; HISTORY],
+    usage: [f32; HISTORY],
     len: usize,
 }
 
@@ -129,6 +133,7 @@ impl Penalties {
     pub const NONE: Self = Self {
         segment: [0; HISTORY],
         cost: [0.0; HISTORY],
+        usage: [0.0; HISTORY],
         len: 0,
     };
 
@@ -158,6 +163,7 @@ impl Penalties {
                     }
                     p.segment[p.len] = visit.segment;
                     p.cost[p.len] = 0.0;
+                    p.usage[p.len] = 0.0;
                     p.len += 1;
                     let k = p.len - 1;
                     let age = now.saturating_sub(visit.tick);
@@ -170,7 +176,9 @@ impl Penalties {
             };
             if usage_ticks > 0 && end > window_start {
                 let played = end - visit.tick.max(window_start);
-                p.cost[k] += v.usage_cost * played as f32 / usage_ticks as f32;
+                let u = v.usage_cost * played as f32 / usage_ticks as f32;
+                p.cost[k] += u;
+                p.usage[k] += u;
             }
             end = visit.tick;
             if end <= window_start && visit.tick.saturating_add(recency_ticks) <= now {
@@ -188,6 +196,14 @@ impl Penalties {
             .position(|&s| s as usize == c)
             .map_or(0.0, |k| self.cost[k])
     }
+
+    /// The usage part of the penalty of segment `c` (what continuing it is charged).
+    pub fn usage_of(&self, c: usize) -> f32 {
+        self.segment[..self.len]
+            .iter()
+            .position(|&s| s as usize == c)
+            .map_or(0.0, |k| self.usage[k])
+    }
 }
 
 fn dot<T: PolicyTables + ?Sized>(t: &T, b: &[f32], f: impl Fn(&T, usize) -> f32) -> f32 {
@@ -199,7 +215,8 @@ fn dot<T: PolicyTables + ?Sized>(t: &T, b: &[f32], f: impl Fn(&T, usize) -> f32)
 }
 
 /// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries), each
-/// candidate segment `c` charged `penalty.of(c)` on top. At an end exit with no successor (a
+/// candidate segment `c` charged `penalty.of(c)` on top and continuing charged the usage of
+/// the exit's segment, `penalty.usage_of(..)`. At an end exit with no successor (a
 /// blob whose pruning left none) the choice falls back to entering segment 0, so playback
 /// never stalls.
 pub fn select<T: PolicyTables + ?Sized>(
@@ -215,7 +232,7 @@ pub fn select<T: PolicyTables + ?Sized>(
         candidates: 0,
     };
     if !t.exit_is_end(e) {
-        best.cost = dot(t, b, |t, s| t.u_cont(e, s));
+        best.cost = dot(t, b, |t, s| t.u_cont(e, s)) + penalty.usage_of(t.exit_segment(e));
         best.candidates = 1;
     }
     for k in 0..t.successor_count(e) {
@@ -325,5 +342,61 @@ mod tests {
         let d = select(&Two, 0, &[1.0], &p);
         assert_eq!(d.choice, Choice::Enter(1));
         assert_eq!(d.cost, 1.5);
+    }
+
+    /// Segment 0 at an interruption exit: continuing costs 1.0, entering segment 1 costs 1.5.
+    struct Playing;
+    impl PolicyTables for Playing {
+        fn states(&self) -> usize {
+            1
+        }
+        fn exit_count(&self) -> usize {
+            2
+        }
+        fn exit_segment(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_frame(&self, e: usize) -> usize {
+            10 * e
+        }
+        fn exit_is_end(&self, e: usize) -> bool {
+            e == 1
+        }
+        fn first_exit(&self, _: usize) -> usize {
+            0
+        }
+        fn u(&self, _: usize, _: usize) -> f32 {
+            1.5
+        }
+        fn u_cont(&self, _: usize, _: usize) -> f32 {
+            1.0
+        }
+        fn successor_count(&self, _: usize) -> usize {
+            1
+        }
+        fn successor(&self, _: usize, _: usize) -> (usize, f32) {
+            (1, 0.0)
+        }
+    }
+
+    /// Continuing is charged the playing segment's usage, not its recency: just entered, it
+    /// plays on; after dominating the usage window it gives way.
+    #[test]
+    fn continuing_pays_usage_but_not_recency() {
+        let v = Variety {
+            recency_cost: 5.0,
+            recency_ms: 0,
+            usage_cost: 1.0,
+            usage_ms: 0,
+        };
+        // Entered 5 ticks ago: recency 5 * 0.95, usage 1 * 5/100.
+        let p = Penalties::new(&v, &history(&[(0, 95)]), 100, 100, 100);
+        assert!((p.usage_of(0) - 0.05).abs() < 1e-6);
+        let d = select(&Playing, 0, &[1.0], &p);
+        assert_eq!(d.choice, Choice::Continue);
+        assert!((d.cost - 1.05).abs() < 1e-6, "{}", d.cost);
+        // Playing for the whole 100-tick window: continuing costs 1 + 1 > 1.5.
+        let p = Penalties::new(&v, &history(&[(0, 0)]), 100, 100, 100);
+        assert_eq!(select(&Playing, 0, &[1.0], &p).choice, Choice::Enter(1));
     }
 }

@@ -554,3 +554,45 @@ fn a_held_belief_decides_instead_of_the_crf() {
         assert!(e.iter().all(|&(_, c)| c == want), "{held:?}: {e:?}");
     }
 }
+
+#[test]
+fn an_interruption_exit_stays_armed_for_an_onset_within_the_longest_wait() {
+    // Past an interruption frame without an onset, the segment plays on and the exit is
+    // decided on an onset that comes within 300 ms (9 ticks) and before the next exit.
+    let audio = speech(8.0);
+    let recs = run(&audio, 160);
+    let onsets: Vec<u64> = recs
+        .iter()
+        .filter_map(|r| match r {
+            Rec::Onset(t, _) => Some(*t),
+            _ => None,
+        })
+        .collect();
+    let mut armed = 0;
+    for r in &recs {
+        let Rec::Decision(t, e, _) = *r else {
+            continue;
+        };
+        let (seg, frame, end) = EXITS[e];
+        if end {
+            continue;
+        }
+        let shown = recs
+            .iter()
+            .filter_map(|r| match r {
+                Rec::Pose(k, p) if *k <= t && p[0] == (seg * 100 + frame) as f32 => Some(*k),
+                _ => None,
+            })
+            .max()
+            .expect("the exit frame was shown");
+        assert!(t - shown <= 9, "exit {e} decided {} ticks late", t - shown);
+        assert!(
+            onsets.iter().any(|&o| o <= t && t - o <= 1),
+            "exit {e} at tick {t} without an onset"
+        );
+        if t > shown {
+            armed += 1;
+        }
+    }
+    assert!(armed > 0, "no interruption exit decided after its frame");
+}

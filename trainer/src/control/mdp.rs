@@ -2,17 +2,27 @@
 //! way"; the paper's section 7 and appendix).
 //!
 //! Decisions happen at exit points. At exit point `e` of segment `a`, in hidden state `s`, the
-//! controller either continues `a` (interruption exits only; costs nothing) or enters a
-//! segment `c` at its first frame, paying `psi_c(s) + S(e, c)`. Between decisions the state
-//! evolves without observations as `P^n`, `P` the row-normalized CRF transition matrix and `n`
-//! the number of steps the played frames span (their duration over the mean step duration).
-//! With discount `gamma` per decision:
+//! controller either continues `a` (interruption exits only) or enters a segment `c` at its
+//! first frame, paying `S(e, c)`. Between decisions the state evolves without observations as
+//! `P^n`, `P` the row-normalized CRF transition matrix and `n` the number of steps the played
+//! frames span (their duration over the mean step duration). With discount `gamma` per
+//! decision:
 //!
 //! ```text
-//! U(c, s)      = psi_c(s) + gamma * sum_s' P^n(c)(s, s') Q(first_exit(c), s')
-//! U_cont(e, s) = gamma * sum_s' P^m(e)(s, s') Q(next_exit(e), s')
+//! U(c, s)      = w_enter(c) psi_c(s) + gamma * sum_s' P^n(c)(s, s') Q(first_exit(c), s')
+//! U_cont(e, s) = w_cont(e) psi_a(s)  + gamma * sum_s' P^m(e)(s, s') Q(next_exit(e), s')
 //! Q(e, s)      = min( U_cont(e, s) [interruption exits], min_c S(e, c) + U(c, s) )
 //! ```
+//!
+//! **The fit is paid as the segment plays** (beyond the paper, where entering pays all of
+//! `psi_c` and continuing is free): `w_enter(c)` is the share of `c`'s frames up to its first
+//! exit, `w_cont(e)` the share from `e` to the next exit, so a segment played whole still pays
+//! `psi` once. With the paper's rule, continuing a long segment at an interruption exit cost
+//! nothing while leaving it paid a whole new `psi`, so the policy never left long segments: on
+//! the 9-joint ZeroEGGS library a 9-second segment played on through every interruption exit
+//! and took a third of 50 s of new speech. Paid per interval, continuing costs what the
+//! segment's fit to the belief costs for that stretch, and a badly fitting long segment is
+//! left at its next interruption. [`MdpParams::fit_as_played`] = `false` gives the paper's rule.
 //!
 //! The source exit enters the value of a candidate only through `S(e, c)`, so the full
 //! `V(c, e, s) = S(e, c) + U(c, s)` never needs to be stored: `U` (segments x states),
@@ -35,6 +45,9 @@ pub struct MdpParams {
     pub max_iter: usize,
     /// Stop when no value changes by more than this.
     pub tol: f64,
+    /// Pay a segment's fit `psi` over its exit intervals as it plays (default) instead of all
+    /// on entering (the paper; see the module docs).
+    pub fit_as_played: bool,
 }
 
 impl Default for MdpParams {
@@ -44,6 +57,7 @@ impl Default for MdpParams {
             step_s: 0.3,
             max_iter: 1000,
             tol: 1e-7,
+            fit_as_played: true,
         }
     }
 }
@@ -130,10 +144,43 @@ pub fn step_counts(lib: &Library, p: &MdpParams) -> (Vec<usize>, Vec<Option<usiz
     (enter, cont)
 }
 
-/// Step counts (see [`step_counts`]) and the powers of `p` they need.
-type Propagation = (Vec<usize>, Vec<Option<usize>>, Vec<Vec<Vec<f64>>>);
+/// The share of a segment's fit paid on entering it (`w_enter`, per segment) and on
+/// continuing at each exit (`w_cont`, per exit; 0 at end exits): the share of the segment's
+/// frames up to the next exit (see the module docs); 1 and 0 with the paper's rule.
+pub fn fit_shares(lib: &Library, p: &MdpParams) -> (Vec<f64>, Vec<f64>) {
+    let len = |c: usize| (lib.segments[c].len() as f64).max(1.0);
+    let enter = (0..lib.segments.len())
+        .map(|c| {
+            if p.fit_as_played {
+                ((lib.exits[lib.first_exit[c]].frame + 1) as f64 / len(c)).min(1.0)
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let cont = (0..lib.exits.len())
+        .map(|e| match lib.next_exit(e) {
+            Some(n) if p.fit_as_played => {
+                (lib.exits[n].frame - lib.exits[e].frame) as f64 / len(lib.exits[e].segment)
+            }
+            _ => 0.0,
+        })
+        .collect();
+    (enter, cont)
+}
+
+/// Step counts (see [`step_counts`]), the powers of `p` they need, and the fit shares (see
+/// [`fit_shares`]).
+struct Propagation {
+    enter: Vec<usize>,
+    cont: Vec<Option<usize>>,
+    pw: Vec<Vec<Vec<f64>>>,
+    w_enter: Vec<f64>,
+    w_cont: Vec<f64>,
+}
 
 fn propagation(lib: &Library, p: &[Vec<f64>], params: &MdpParams) -> Propagation {
+    let (w_enter, w_cont) = fit_shares(lib, params);
     let (enter, cont) = step_counts(lib, params);
     let max_n = enter
         .iter()
@@ -142,7 +189,13 @@ fn propagation(lib: &Library, p: &[Vec<f64>], params: &MdpParams) -> Propagation
         .max()
         .unwrap_or(0);
     let pw = powers(p, max_n);
-    (enter, cont, pw)
+    Propagation {
+        enter,
+        cont,
+        pw,
+        w_enter,
+        w_cont,
+    }
 }
 
 fn propagate(pn: &[Vec<f64>], q: &[f64]) -> Vec<f64> {
@@ -160,7 +213,13 @@ pub fn solve(
     params: &MdpParams,
 ) -> Policy {
     let s = p.len();
-    let (enter, cont, pw) = propagation(lib, p, params);
+    let Propagation {
+        enter,
+        cont,
+        pw,
+        w_enter,
+        w_cont,
+    } = propagation(lib, p, params);
     let n_seg = lib.segments.len();
     let n_exit = lib.exits.len();
     let mut q = vec![vec![0.0; s]; n_exit];
@@ -174,7 +233,7 @@ pub fn solve(
             .map(|c| {
                 let fut = propagate(&pw[enter[c]], &q[lib.first_exit[c]]);
                 (0..s)
-                    .map(|k| psi[c][k] + params.discount * fut[k])
+                    .map(|k| w_enter[c] * psi[c][k] + params.discount * fut[k])
                     .collect()
             })
             .collect();
@@ -183,7 +242,10 @@ pub fn solve(
             .map(|e| {
                 cont[e].map(|m| {
                     let fut = propagate(&pw[m], &q[e + 1]);
-                    fut.iter().map(|v| params.discount * v).collect()
+                    let a = lib.exits[e].segment;
+                    (0..s)
+                        .map(|k| w_cont[e] * psi[a][k] + params.discount * fut[k])
+                        .collect()
                 })
             })
             .collect();
@@ -268,7 +330,13 @@ pub fn unfactorized_q(
     sweeps: usize,
 ) -> Vec<Vec<f64>> {
     let s = p.len();
-    let (enter, cont, pw) = propagation(lib, p, params);
+    let Propagation {
+        enter,
+        cont,
+        pw,
+        w_enter,
+        w_cont,
+    } = propagation(lib, p, params);
     let mut q = vec![vec![0.0; s]; lib.exits.len()];
     for _ in 0..sweeps {
         let mut v = vec![vec![vec![0.0; s]; lib.segments.len()]; lib.exits.len()];
@@ -278,7 +346,7 @@ pub fn unfactorized_q(
                     let fut: f64 = (0..s)
                         .map(|j| pw[enter[c]][k][j] * q[lib.first_exit[c]][j])
                         .sum();
-                    v[e][c][k] = succ[e][c] + psi[c][k] + params.discount * fut;
+                    v[e][c][k] = succ[e][c] + w_enter[c] * psi[c][k] + params.discount * fut;
                 }
             }
         }
@@ -287,7 +355,8 @@ pub fn unfactorized_q(
             for k in 0..s {
                 if let Some(m) = cont[e] {
                     let fut: f64 = (0..s).map(|j| pw[m][k][j] * q[e + 1][j]).sum();
-                    next[e][k] = params.discount * fut;
+                    let a = lib.exits[e].segment;
+                    next[e][k] = w_cont[e] * psi[a][k] + params.discount * fut;
                 }
                 for c in 0..lib.segments.len() {
                     next[e][k] = next[e][k].min(v[e][c][k]);

@@ -84,10 +84,14 @@ mod tests {
         let lib = small_library(20.0);
         assert!(lib.segments.len() >= 5, "{} segments", lib.segments.len());
         let (psi, succ, p) = random_problem(&lib, 3, 1);
-        for sweeps in [1usize, 2, 5, 12] {
+        for (sweeps, fit_as_played) in [1usize, 2, 5, 12]
+            .into_iter()
+            .flat_map(|n| [(n, true), (n, false)])
+        {
             let params = MdpParams {
                 max_iter: sweeps,
                 tol: 0.0,
+                fit_as_played,
                 ..MdpParams::default()
             };
             let fact = mdp::solve(&lib, &psi, succ.clone(), &p, &params);
@@ -101,6 +105,64 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A segment played whole pays its fit once, however it is split by exit points; the
+    /// paper's rule pays it all on entering.
+    #[test]
+    fn fit_shares_of_a_segment_sum_to_one() {
+        let lib = small_library(20.0);
+        let (w_enter, w_cont) = mdp::fit_shares(&lib, &MdpParams::default());
+        for c in 0..lib.segments.len() {
+            let f = lib.first_exit[c];
+            let sum: f64 = w_enter[c]
+                + (f..lib.exits.len())
+                    .take_while(|&e| lib.exits[e].segment == c)
+                    .map(|e| w_cont[e])
+                    .sum::<f64>();
+            assert!((sum - 1.0).abs() < 1e-12, "segment {c}: {sum}");
+            assert!(w_enter[c] > 0.0 && w_enter[c] <= 1.0);
+        }
+        let paper = MdpParams {
+            fit_as_played: false,
+            ..MdpParams::default()
+        };
+        let (w_enter, w_cont) = mdp::fit_shares(&lib, &paper);
+        assert!(w_enter.iter().all(|&w| w == 1.0) && w_cont.iter().all(|&w| w == 0.0));
+    }
+
+    /// One state; the longest segment fits badly (psi 10), every other well (0.5). Under the
+    /// paper's rule its fit is paid on entering, so at its first interruption exit continuing
+    /// is free and wins; paid as it plays, continuing costs a share of 10 and it is left.
+    #[test]
+    fn a_badly_fitting_long_segment_is_left_at_an_interruption() {
+        let lib = small_library(30.0);
+        let long = (0..lib.segments.len())
+            .max_by_key(|&c| lib.segments[c].len())
+            .unwrap();
+        let e = lib.first_exit[long];
+        assert!(
+            !lib.exits[e].end,
+            "the longest segment has interruption exits"
+        );
+        let psi: Vec<Vec<f64>> = (0..lib.segments.len())
+            .map(|c| vec![if c == long { 10.0 } else { 0.5 }])
+            .collect();
+        let sig = costs::Signatures::new(&lib);
+        let succ = costs::successor_costs(&lib, &sig, &costs::CostParams::default());
+        let p = vec![vec![1.0]];
+        let all = 0..lib.segments.len();
+        let paper = MdpParams {
+            fit_as_played: false,
+            ..MdpParams::default()
+        };
+        let pol = mdp::solve(&lib, &psi, succ.clone(), &p, &paper);
+        assert_eq!(pol.decide(e, &[1.0], all.clone()), mdp::Action::Continue);
+        let pol = mdp::solve(&lib, &psi, succ, &p, &MdpParams::default());
+        assert!(matches!(
+            pol.decide(e, &[1.0], all),
+            mdp::Action::Enter(c) if c != long
+        ));
     }
 
     #[test]
