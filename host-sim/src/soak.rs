@@ -210,7 +210,12 @@ pub fn soak(blob: &Blob<'_>, hours: f64, seed: u64) -> Result<SoakReport, String
     rep.rss_kib[2] = rss_kib();
     rep.audio_s = pushed as f64 / rate as f64;
     rep.wall_s = start.elapsed().as_secs_f64();
-    rep.tick_drift = rep.ticks as i64 - (rep.audio_s * fps).floor() as i64;
+    // The audio clock as the device keeps it: tick k is due once ceil(k * rate / fps)
+    // samples have come, fps in milli-frames per second (so a 1/60.0001 s frame time runs at
+    // exactly 60 fps), tick 0 at the first sample.
+    let fps_milli = (fps * 1000.0).round() as u64;
+    let due = (pushed as u128 * fps_milli as u128 / (rate as u128 * 1000).max(1)) as i64 + 1;
+    rep.tick_drift = rep.ticks as i64 - due;
     Ok(rep)
 }
 
