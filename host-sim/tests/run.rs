@@ -76,7 +76,11 @@ fn soak_finds_no_violation_drift_or_growth() {
         3,
     )
     .unwrap();
-    assert!(r.ok(), "{r:?}");
+    // The memory check is the subprocess's above: this process's resident memory also counts
+    // the tests running beside this one.
+    assert_eq!(r.tick_drift, 0, "{r:?}");
+    assert_eq!((r.pose_violations, r.duty_violations), (0, 0), "{r:?}");
+    assert!(r.longest_without_step_s <= 2.0, "{r:?}");
     assert!((r.audio_s - 360.0).abs() < 1e-9, "{r:?}");
     assert!(r.steps > 360 && r.decisions > 10, "{r:?}");
 }
