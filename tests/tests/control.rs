@@ -228,3 +228,118 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
         "{online:?} vs {random:?}"
     );
 }
+
+/// The same requirements on the 9-joint take (a model fitted on its first 90 s, its own
+/// library), and on another character's library (Bandai, 13 clips in the normal style): the
+/// speech matters (on the held-out 90-121 s the hands' speed follows the intensity more than
+/// with random choices, time-shuffled audio or the belief held at the prior), long segments do
+/// not take over (no segment above 15 % of two minutes of another speaker), cuts jump less than
+/// random ones and no more than the capture's own 99th percentile step.
+#[test]
+fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_bandai() {
+    use clap::Parser;
+    let test = "online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_bandai";
+    let Some(d) = data(test) else {
+        return;
+    };
+    let Some(nine) = e2e_tests::shared_data(test, "zeroeggs-001-neutral-9joint") else {
+        return;
+    };
+    let Some(bandai) = e2e_tests::shared_data(test, "bandai-namco-gestures") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model.json");
+    let fit = FitCli::parse_from([
+        "fit".as_ref(),
+        "--corpus".as_ref(),
+        nine.as_os_str(),
+        "--span".as_ref(),
+        "0:90".as_ref(),
+        "--out".as_ref(),
+        model.as_os_str(),
+    ]);
+    gesture_trainer::cli::fit::run(&fit.args).unwrap();
+    let eval = |library: Vec<PathBuf>, extra: Vec<&std::ffi::OsStr>| {
+        let mut argv: Vec<&std::ffi::OsStr> = vec![
+            "eval-motion".as_ref(),
+            "--model".as_ref(),
+            model.as_os_str(),
+            "--library".as_ref(),
+        ];
+        argv.extend(library.iter().map(|p| p.as_os_str()));
+        argv.extend(extra);
+        gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap()
+    };
+    let get = |rows: &gesture_trainer::evaluate::motion::Evaluation, m: &str| {
+        rows.rows.iter().find(|r| r.method == m).unwrap().metrics
+    };
+    let wav = nine.join("001_Neutral_0_x_1_0.wav");
+    let bvh = nine.join("001_Neutral_0_x_1_0.bvh");
+    let own = eval(
+        vec![nine.clone()],
+        vec![
+            "--audio".as_ref(),
+            wav.as_os_str(),
+            "--mocap".as_ref(),
+            bvh.as_os_str(),
+            "--span".as_ref(),
+            "90:121".as_ref(),
+        ],
+    );
+    let coupling = |m: &str| get(&own, m).speech_coupling;
+    let (online, mocap) = (get(&own, "online"), get(&own, "mocap"));
+    eprintln!("9-joint 90-121 s: online {online:?}\nmocap {mocap:?}");
+    for other in ["random", "online_shuffled", "online_prior"] {
+        assert!(
+            coupling("online") > coupling(other),
+            "coupling online {} vs {other} {}",
+            coupling("online"),
+            coupling(other)
+        );
+    }
+    assert!(online.mean_jerk <= 1.5 * mocap.mean_jerk, "{online:?}");
+    assert!(online.max_jump_at_cuts <= mocap.p99_step, "{online:?}");
+
+    let scott = d.join("beat-scott");
+    let (s1, s2) = (
+        scott.join("2_scott_0_1_1.wav"),
+        scott.join("2_scott_0_2_2.wav"),
+    );
+    let other = eval(
+        vec![nine.clone()],
+        vec!["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()],
+    );
+    let (online, random) = (get(&other, "online"), get(&other, "random"));
+    eprintln!("beat-scott: online {online:?}\nrandom {random:?}");
+    assert!(online.max_segment_share <= 0.15, "{online:?}");
+    assert!(online.repeat_5s_share <= 0.10, "{online:?}");
+    assert!(online.jump_at_cuts <= random.jump_at_cuts, "{online:?}");
+
+    // Another character: the Bandai clips in the normal style.
+    let mut clips: Vec<PathBuf> = Vec::new();
+    for set in ["dataset-1", "dataset-2"] {
+        for e in std::fs::read_dir(bandai.join(set)).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            if name.ends_with(".bvh") && (set == "dataset-2" || name.contains("_normal_")) {
+                clips.push(p);
+            }
+        }
+    }
+    clips.sort();
+    assert_eq!(clips.len(), 13, "{clips:?}");
+    let band = eval(
+        clips,
+        vec![
+            "--audio".as_ref(),
+            s1.as_os_str(),
+            "--span".as_ref(),
+            "0:60".as_ref(),
+        ],
+    );
+    let online = get(&band, "online");
+    eprintln!("bandai: online {online:?}");
+    assert!(online.max_segment_share <= 0.15, "{online:?}");
+    assert!(online.repeat_5s_share <= 0.10, "{online:?}");
+}
