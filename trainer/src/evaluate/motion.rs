@@ -2,7 +2,8 @@
 //! measured the same way ([`crate::evaluate::metrics`]):
 //!
 //! - `online`: the controller as a board runs it;
-//! - `online_pure`: the same without variety costs (the paper's decision rule);
+//! - `online_pure`: the same tables without the variety costs (the paper's selection rule
+//!   over this blob's tables);
 //! - `online_prior`: an ablation, the belief held at the state prior (the speech's prosody
 //!   no longer informs the choice; decisions are still timed on its onsets);
 //! - `online_shuffled`: an ablation, the controller on the audio cut into 1 s blocks played
