@@ -110,6 +110,10 @@ pub struct Policy {
     pub q: Vec<Vec<f64>>,
     /// Discount per decision the values were computed with.
     pub discount: f64,
+    /// Share of each segment's fit paid on entering it (see [`fit_shares`]).
+    pub w_enter: Vec<f64>,
+    /// Share of its segment's fit paid on continuing at each exit (see [`fit_shares`]).
+    pub w_cont: Vec<f64>,
     /// Value-iteration sweeps.
     pub iterations: usize,
     /// Largest change in the last sweep.
@@ -281,6 +285,8 @@ pub fn solve(
         succ,
         q,
         discount: params.discount,
+        w_enter,
+        w_cont,
         iterations,
         residual,
     }

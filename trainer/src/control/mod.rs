@@ -226,12 +226,16 @@ mod tests {
             match pol.decide(e, &b, 0..lib.segments.len()) {
                 Action::Continue => {
                     let n = lib.next_exit(e).unwrap();
+                    let a = lib.exits[e].segment;
+                    greedy +=
+                        pol.w_cont[e] * b.iter().zip(&psi[a]).map(|(x, y)| x * y).sum::<f64>();
                     t += (lib.exits[n].frame - lib.exits[e].frame).max(1);
                     e = n;
                 }
                 Action::Enter(c) => {
-                    greedy +=
-                        b.iter().zip(&psi[c]).map(|(x, y)| x * y).sum::<f64>() + pol.succ[e][c];
+                    greedy += pol.w_enter[c]
+                        * b.iter().zip(&psi[c]).map(|(x, y)| x * y).sum::<f64>()
+                        + pol.succ[e][c];
                     t += lib.exits[lib.first_exit[c]].frame + 1;
                     e = lib.first_exit[c];
                 }
