@@ -10,12 +10,12 @@
 //! decides with the belief as it stands.
 //!
 //! **Decisions on syllable onsets** ([`DecisionTiming`]). By default, decisions are timed
-//! against the speech, so that new gestures start with syllables: an interruption exit is only
-//! decided at on a syllable onset detected within the last `onset_window_ms` or within
-//! `max_wait_ms` after its frame, the segment playing on meanwhile (without one, and once the
-//! segment's next exit point comes, it plays on as if the policy had chosen to continue; a
-//! long segment is so left on the speech rather than only if an onset happens to fall on one
-//! of its few interruption frames), and at a segment's end the
+//! against the speech, so that new gestures start with syllables. An interruption exit is
+//! decided only on a syllable onset: one detected within the last `onset_window_ms`, or one
+//! that comes within `max_wait_ms` after the exit's frame while the segment plays on. Without
+//! one (or once the segment's next exit point comes first) the segment plays on, as if the
+//! policy had chosen to continue; so a long segment can be left on the speech, not only when
+//! an onset happens to fall on one of its few interruption frames. At a segment's end the
 //! controller waits for an onset, for at most `max_wait_ms`, before deciding. **The body never
 //! stops while it waits**: the player runs on into the segment's recorded successor (the
 //! frames that followed it in the capture); choosing that successor then simply continues it,
