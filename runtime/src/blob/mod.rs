@@ -25,7 +25,7 @@
 //!   [`LibraryFrames`](crate::player::LibraryFrames);
 //! - `skeleton`: the host-side skeleton section ([`SkeletonView`], [`BvhChannel`] codes);
 //! - `error`: [`BlobError`], named by phase and field;
-//! - [`encode`](mod@encode) (feature `encode`): owned sections, table layout and the
+//! - `encode` (feature `encode`): owned sections, table layout and the
 //!   serializer, checked against [`Blob::parse`].
 //!
 //! **Invariants.** [`Blob::parse`] is the only gate: it never panics and never allocates for
