@@ -189,20 +189,21 @@ impl Penalties {
         p
     }
 
-    /// The penalty of segment `c`.
-    pub fn of(&self, c: usize) -> f32 {
+    /// Where segment `c` sits among the visited segments.
+    fn slot(&self, c: usize) -> Option<usize> {
         self.segment[..self.len]
             .iter()
             .position(|&s| s as usize == c)
-            .map_or(0.0, |k| self.cost[k])
+    }
+
+    /// The penalty of segment `c`.
+    pub fn of(&self, c: usize) -> f32 {
+        self.slot(c).map_or(0.0, |k| self.cost[k])
     }
 
     /// The usage part of the penalty of segment `c` (what continuing it is charged).
     pub fn usage_of(&self, c: usize) -> f32 {
-        self.segment[..self.len]
-            .iter()
-            .position(|&s| s as usize == c)
-            .map_or(0.0, |k| self.usage[k])
+        self.slot(c).map_or(0.0, |k| self.usage[k])
     }
 }
 

@@ -374,16 +374,31 @@ const EXITS: [(usize, usize, bool); 5] = [
     (2, 29, true),
 ];
 
-/// The tick at or before `t` that last showed segment `seg`'s last frame (channel 0 =
+/// The tick at or before `t` that last showed frame `frame` of segment `seg` (channel 0 =
 /// segment * 100 + frame).
-fn last_frame_tick(recs: &[Rec], seg: usize, t: u64) -> Option<u64> {
-    let last = (seg * 100 + [20, 12, 30][seg] - 1) as f32;
+fn frame_tick(recs: &[Rec], seg: usize, frame: usize, t: u64) -> Option<u64> {
+    let value = (seg * 100 + frame) as f32;
     recs.iter()
         .filter_map(|r| match r {
-            Rec::Pose(k, p) if *k <= t && p[0] == last => Some(*k),
+            Rec::Pose(k, p) if *k <= t && p[0] == value => Some(*k),
             _ => None,
         })
         .max()
+}
+
+/// The tick at or before `t` that last showed segment `seg`'s last frame.
+fn last_frame_tick(recs: &[Rec], seg: usize, t: u64) -> Option<u64> {
+    frame_tick(recs, seg, [20, 12, 30][seg] - 1, t)
+}
+
+/// The ticks at which syllable onsets were detected.
+fn onset_ticks(recs: &[Rec]) -> Vec<u64> {
+    recs.iter()
+        .filter_map(|r| match r {
+            Rec::Onset(t, _) => Some(*t),
+            _ => None,
+        })
+        .collect()
 }
 
 #[test]
@@ -447,13 +462,7 @@ fn in_silence_interruptions_pass_and_segment_ends_wait_running_on() {
 fn with_speech_every_decision_follows_an_onset_or_the_longest_wait() {
     let audio = speech(8.0);
     let recs = run(&audio, 160);
-    let onsets: Vec<u64> = recs
-        .iter()
-        .filter_map(|r| match r {
-            Rec::Onset(t, _) => Some(*t),
-            _ => None,
-        })
-        .collect();
+    let onsets = onset_ticks(&recs);
     assert!(onsets.len() >= 15, "{} onsets", onsets.len());
     let pose_at = |tick: u64| {
         recs.iter().find_map(|r| match r {
@@ -561,13 +570,7 @@ fn an_interruption_exit_stays_armed_for_an_onset_within_the_longest_wait() {
     // decided on an onset that comes within 300 ms (9 ticks) and before the next exit.
     let audio = speech(8.0);
     let recs = run(&audio, 160);
-    let onsets: Vec<u64> = recs
-        .iter()
-        .filter_map(|r| match r {
-            Rec::Onset(t, _) => Some(*t),
-            _ => None,
-        })
-        .collect();
+    let onsets = onset_ticks(&recs);
     let mut armed = 0;
     for r in &recs {
         let Rec::Decision(t, e, _) = *r else {
@@ -577,14 +580,7 @@ fn an_interruption_exit_stays_armed_for_an_onset_within_the_longest_wait() {
         if end {
             continue;
         }
-        let shown = recs
-            .iter()
-            .filter_map(|r| match r {
-                Rec::Pose(k, p) if *k <= t && p[0] == (seg * 100 + frame) as f32 => Some(*k),
-                _ => None,
-            })
-            .max()
-            .expect("the exit frame was shown");
+        let shown = frame_tick(&recs, seg, frame, t).expect("the exit frame was shown");
         assert!(t - shown <= 9, "exit {e} decided {} ticks late", t - shown);
         assert!(
             onsets.iter().any(|&o| o <= t && t - o <= 1),

@@ -129,13 +129,57 @@ struct EvalCli {
     args: gesture_trainer::cli::eval_motion::EvalMotionArgs,
 }
 
+/// `fit --corpus CORPUS --span SPAN --out MODEL` with the command line's defaults.
+fn fit_model(corpus: &std::path::Path, span: &str, model: &std::path::Path) {
+    use clap::Parser;
+    let fit = FitCli::parse_from([
+        "fit".as_ref(),
+        "--corpus".as_ref(),
+        corpus.as_os_str(),
+        "--span".as_ref(),
+        span.as_ref(),
+        "--out".as_ref(),
+        model.as_os_str(),
+    ]);
+    gesture_trainer::cli::fit::run(&fit.args).unwrap();
+}
+
+/// `eval-motion --model MODEL --library LIBRARY... EXTRA...` with the command line's defaults.
+fn eval_motion(
+    model: &std::path::Path,
+    library: &[PathBuf],
+    extra: &[&std::ffi::OsStr],
+) -> gesture_trainer::evaluate::motion::Evaluation {
+    use clap::Parser;
+    let mut argv: Vec<&std::ffi::OsStr> = vec![
+        "eval-motion".as_ref(),
+        "--model".as_ref(),
+        model.as_os_str(),
+        "--library".as_ref(),
+    ];
+    argv.extend(library.iter().map(|p| p.as_os_str()));
+    argv.extend(extra);
+    gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap()
+}
+
+/// The metrics of one method's row.
+fn row(
+    rows: &gesture_trainer::evaluate::motion::Evaluation,
+    method: &str,
+) -> gesture_trainer::evaluate::metrics::MotionMetrics {
+    rows.rows
+        .iter()
+        .find(|r| r.method == method)
+        .unwrap()
+        .metrics
+}
+
 /// The motion-quality requirements, with the command-line defaults: a model fitted on ZeroEGGS
 /// 0-40 s and the take's own library, played by the device's online controller (the packed
 /// blob, decisions on syllable onsets) on speech neither saw: the take's last 10 s (against
 /// its own capture) and both beat-scott monologues (another speaker, 2 minutes).
 #[test]
 fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
-    use clap::Parser;
     let Some(d) = data("online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech")
     else {
         return;
@@ -143,16 +187,7 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
     let ze = d.join("zeroeggs-067-speech2");
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("model.json");
-    let fit = FitCli::parse_from([
-        "fit".as_ref(),
-        "--corpus".as_ref(),
-        ze.as_os_str(),
-        "--span".as_ref(),
-        "0:40".as_ref(),
-        "--out".as_ref(),
-        model.as_os_str(),
-    ]);
-    gesture_trainer::cli::fit::run(&fit.args).unwrap();
+    fit_model(&ze, "0:40", &model);
     let wav = ze.join("067_Speech_2_first50s.wav");
     let bvh = ze.join("067_Speech_2_first50s.bvh");
     let scott = d.join("beat-scott");
@@ -160,23 +195,11 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
         scott.join("2_scott_0_1_1.wav"),
         scott.join("2_scott_0_2_2.wav"),
     );
-    let eval = |extra: Vec<&std::ffi::OsStr>| {
-        let mut argv: Vec<&std::ffi::OsStr> = vec![
-            "eval-motion".as_ref(),
-            "--model".as_ref(),
-            model.as_os_str(),
-            "--library".as_ref(),
-            ze.as_os_str(),
-        ];
-        argv.extend(extra);
-        gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap()
-    };
-    let get = |rows: &gesture_trainer::evaluate::motion::Evaluation, m: &str| {
-        rows.rows.iter().find(|r| r.method == m).unwrap().metrics
-    };
+    let library = [ze.clone()];
+    let eval = |extra: &[&std::ffi::OsStr]| eval_motion(&model, &library, extra);
 
     // Against the capture of the same speech.
-    let own = eval(vec![
+    let own = eval(&[
         "--audio".as_ref(),
         wav.as_os_str(),
         "--mocap".as_ref(),
@@ -184,7 +207,7 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
         "--span".as_ref(),
         "40:50".as_ref(),
     ]);
-    let (online, mocap) = (get(&own, "online"), get(&own, "mocap"));
+    let (online, mocap) = (row(&own, "online"), row(&own, "mocap"));
     eprintln!("zeroeggs 40-50 s: online {online:?}\nmocap {mocap:?}");
     assert!(
         (online.still_share - mocap.still_share).abs() <= 0.02,
@@ -212,8 +235,8 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
     );
 
     // Two minutes of another speaker.
-    let other = eval(vec!["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()]);
-    let (online, random) = (get(&other, "online"), get(&other, "random"));
+    let other = eval(&["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()]);
+    let (online, random) = (row(&other, "online"), row(&other, "random"));
     eprintln!("beat-scott: online {online:?}\nrandom {random:?}");
     assert!(online.seconds > 120.0, "{}", online.seconds);
     assert!(online.library_share.unwrap() >= 0.5, "{online:?}");
@@ -237,7 +260,6 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
 /// random ones and no more than the capture's own 99th percentile step.
 #[test]
 fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_bandai() {
-    use clap::Parser;
     let test = "online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_bandai";
     let Some(d) = data(test) else {
         return;
@@ -250,35 +272,13 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
     };
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("model.json");
-    let fit = FitCli::parse_from([
-        "fit".as_ref(),
-        "--corpus".as_ref(),
-        nine.as_os_str(),
-        "--span".as_ref(),
-        "0:90".as_ref(),
-        "--out".as_ref(),
-        model.as_os_str(),
-    ]);
-    gesture_trainer::cli::fit::run(&fit.args).unwrap();
-    let eval = |library: Vec<PathBuf>, extra: Vec<&std::ffi::OsStr>| {
-        let mut argv: Vec<&std::ffi::OsStr> = vec![
-            "eval-motion".as_ref(),
-            "--model".as_ref(),
-            model.as_os_str(),
-            "--library".as_ref(),
-        ];
-        argv.extend(library.iter().map(|p| p.as_os_str()));
-        argv.extend(extra);
-        gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap()
-    };
-    let get = |rows: &gesture_trainer::evaluate::motion::Evaluation, m: &str| {
-        rows.rows.iter().find(|r| r.method == m).unwrap().metrics
-    };
+    fit_model(&nine, "0:90", &model);
     let wav = nine.join("001_Neutral_0_x_1_0.wav");
     let bvh = nine.join("001_Neutral_0_x_1_0.bvh");
-    let own = eval(
-        vec![nine.clone()],
-        vec![
+    let own = eval_motion(
+        &model,
+        std::slice::from_ref(&nine),
+        &[
             "--audio".as_ref(),
             wav.as_os_str(),
             "--mocap".as_ref(),
@@ -287,8 +287,8 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
             "90:121".as_ref(),
         ],
     );
-    let coupling = |m: &str| get(&own, m).speech_coupling;
-    let (online, mocap) = (get(&own, "online"), get(&own, "mocap"));
+    let coupling = |m: &str| row(&own, m).speech_coupling;
+    let (online, mocap) = (row(&own, "online"), row(&own, "mocap"));
     eprintln!("9-joint 90-121 s: online {online:?}\nmocap {mocap:?}");
     for other in ["random", "online_shuffled", "online_prior"] {
         assert!(
@@ -306,11 +306,12 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
         scott.join("2_scott_0_1_1.wav"),
         scott.join("2_scott_0_2_2.wav"),
     );
-    let other = eval(
-        vec![nine.clone()],
-        vec!["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()],
+    let other = eval_motion(
+        &model,
+        std::slice::from_ref(&nine),
+        &["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()],
     );
-    let (online, random) = (get(&other, "online"), get(&other, "random"));
+    let (online, random) = (row(&other, "online"), row(&other, "random"));
     eprintln!("beat-scott: online {online:?}\nrandom {random:?}");
     assert!(online.max_segment_share <= 0.15, "{online:?}");
     assert!(online.repeat_5s_share <= 0.10, "{online:?}");
@@ -329,16 +330,17 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
     }
     clips.sort();
     assert_eq!(clips.len(), 13, "{clips:?}");
-    let band = eval(
-        clips,
-        vec![
+    let band = eval_motion(
+        &model,
+        &clips,
+        &[
             "--audio".as_ref(),
             s1.as_os_str(),
             "--span".as_ref(),
             "0:60".as_ref(),
         ],
     );
-    let online = get(&band, "online");
+    let online = row(&band, "online");
     eprintln!("bandai: online {online:?}");
     assert!(online.max_segment_share <= 0.15, "{online:?}");
     assert!(online.repeat_5s_share <= 0.10, "{online:?}");

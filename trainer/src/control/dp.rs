@@ -6,8 +6,8 @@
 //! to continue (interruption exits) to the next exit, paying `w_cont(e) post(t) . psi_a`, or
 //! to enter segment `c`, paying `w_enter(c) post(t) . psi_c + S(e, c)` and reaching `c`'s
 //! first exit after its frames: the same fit shares as the policy's
-//! ([`super::mdp::fit_shares`]), so the reference optimizes what the online policy does. The cost of the
-//! sequence is the sum; the DP finds its minimum exactly (states: frame x exit point). It is
+//! ([`super::mdp::fit_shares`]), so the reference optimizes what the online policy does. The
+//! cost of the sequence is the sum; the DP finds its minimum exactly (states: frame x exit point). It is
 //! `O(frames x exits x segments)`: meant for evaluation on small libraries, not for packing.
 
 use super::library::Library;
@@ -54,13 +54,17 @@ pub fn best_sequence(
             };
             if let Some(n) = lib.next_exit(e) {
                 let dt = lib.exits[n].frame - ex.frame;
-                let w = policy.w_cont.get(e).copied().unwrap_or(0.0);
                 let fit: f64 = b.iter().zip(&psi[ex.segment]).map(|(x, y)| x * y).sum();
-                relax(t + dt.max(1), n, here + w * fit, Action::Continue);
+                relax(
+                    t + dt.max(1),
+                    n,
+                    here + policy.w_cont[e] * fit,
+                    Action::Continue,
+                );
             }
             for c in 0..lib.segments.len() {
-                let w = policy.w_enter.get(c).copied().unwrap_or(1.0);
-                let fit: f64 = w * b.iter().zip(&psi[c]).map(|(x, y)| x * y).sum::<f64>();
+                let fit: f64 =
+                    policy.w_enter[c] * b.iter().zip(&psi[c]).map(|(x, y)| x * y).sum::<f64>();
                 let v = here + fit + policy.succ[e][c];
                 let first = lib.first_exit[c];
                 relax(t + lib.exits[first].frame + 1, first, v, Action::Enter(c));
