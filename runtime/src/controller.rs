@@ -50,7 +50,10 @@ use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
 use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
-use crate::policy::{select, Choice, Decision, History, Penalties, PolicyTables, Variety, Visit};
+use crate::policy::{
+    select_styled, Choice, Decision, History, Penalties, PolicyTables, Style, StyleError, Variety,
+    Visit,
+};
 use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
 
 /// When the controller decides at exit points (see the module docs).
@@ -206,6 +209,8 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     timing: DecisionTiming,
     variety: Variety,
     history: History,
+    /// The user's tone weights (neutral by default).
+    style: Style,
     /// Belief the policy decides with instead of the CRF's (an evaluation's ablation).
     held_belief: Option<[f32; MAX_STATES]>,
     /// Ticks held at the current motion beat, waiting for an onset.
@@ -266,6 +271,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             timing: DecisionTiming::DEFAULT,
             variety: Variety::NONE,
             history: History::new(),
+            style: Style::NEUTRAL,
             held_belief: None,
             holding: 0,
             last_onset: None,
@@ -338,6 +344,25 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
     /// How decisions vary.
     pub fn variety(&self) -> Variety {
         self.variety
+    }
+
+    /// Sets the style: one weight per tone of the tables (in their order; fewer weights leave
+    /// the rest at 0), applied from the next decision on. See [`Style::new`] for the rules;
+    /// an empty slice is the neutral style. On an error the style in force is kept.
+    pub fn set_style(&mut self, weights: &[f32]) -> Result<(), StyleError> {
+        if weights.len() > self.tables.tones() {
+            return Err(StyleError::TooManyWeights {
+                given: weights.len().min(u32::MAX as usize) as u32,
+                tones: self.tables.tones() as u32,
+            });
+        }
+        self.style = Style::new(weights)?;
+        Ok(())
+    }
+
+    /// The style in force.
+    pub fn style(&self) -> &Style {
+        &self.style
     }
 
     /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
@@ -564,8 +589,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         );
         let s = self.tables.states();
         let decision = match &self.held_belief {
-            Some(h) => select(self.tables, e, &h[..s], &penalties),
-            None => select(self.tables, e, self.belief(), &penalties),
+            Some(h) => select_styled(self.tables, e, &h[..s], &penalties, &self.style),
+            None => select_styled(self.tables, e, self.belief(), &penalties, &self.style),
         };
         match decision.choice {
             Choice::Continue => {

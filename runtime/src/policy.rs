@@ -27,6 +27,13 @@
 //! `gesture-train eval-motion`. All arithmetic is on integer ticks and the same `f32`
 //! operations on host and device, so both choose alike.
 //!
+//! **Style** (docs/method.md "Style control", the paper's section 8.2). A blob may carry value
+//! tables per tone (`U^m`, `U_cont^m`, solved by the trainer with each tone's transform of the
+//! kinematic parameters) beside the neutral ones. A [`Style`] holds the user's weights `d`;
+//! the selector uses `U = d_0 U + sum_m d_m U^m` (and likewise `U_cont`), `d_0 = 1 - sum d_m`
+//! the neutral weight, computed per candidate from the stored tables, so no mixed copy is kept
+//! in RAM. The neutral style reads the neutral tables alone, exactly as a blob without tones.
+//!
 //! The tables come from a validated blob through [`PolicyTables`]; every index the selector
 //! uses was range-checked at load, so nothing here can panic.
 
@@ -55,6 +62,175 @@ pub trait PolicyTables {
     fn successor_count(&self, e: usize) -> usize;
     /// The `k`-th successor of exit `e`: `(segment, S(e, segment))`.
     fn successor(&self, e: usize, k: usize) -> (usize, f32);
+    /// Tones with tables of their own (0: the neutral tables only).
+    fn tones(&self) -> usize {
+        0
+    }
+    /// `U^m(c, s)` of tone `m < tones()`.
+    fn tone_u(&self, _m: usize, c: usize, s: usize) -> f32 {
+        self.u(c, s)
+    }
+    /// `U_cont^m(e, s)` of tone `m < tones()`.
+    fn tone_u_cont(&self, _m: usize, e: usize, s: usize) -> f32 {
+        self.u_cont(e, s)
+    }
+}
+
+/// Most tones a [`Style`] mixes (and a blob carries).
+pub const MAX_TONES: usize = 8;
+
+/// The user's style: a weight per tone and the neutral weight (they sum to 1). Only built
+/// through [`Style::new`], so the weights are always finite, non-negative and normalized.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Style {
+    neutral: f32,
+    tone: [f32; MAX_TONES],
+    tones: usize,
+}
+
+/// Why style weights were refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StyleError {
+    /// More weights than the tables have tones.
+    TooManyWeights {
+        /// Weights given.
+        given: u32,
+        /// Tones of the tables.
+        tones: u32,
+    },
+    /// A weight is NaN or infinite.
+    NotFinite {
+        /// Its index.
+        tone: u32,
+    },
+    /// A weight is negative.
+    Negative {
+        /// Its index.
+        tone: u32,
+    },
+}
+
+impl core::fmt::Display for StyleError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::TooManyWeights { given, tones } => {
+                write!(f, "{given} style weights for {tones} tones")
+            }
+            Self::NotFinite { tone } => write!(f, "style weight {tone} is not a finite number"),
+            Self::Negative { tone } => write!(f, "style weight {tone} is negative"),
+        }
+    }
+}
+
+impl core::error::Error for StyleError {}
+
+impl Style {
+    /// Neutral: the policy's own tables.
+    pub const NEUTRAL: Self = Self {
+        neutral: 1.0,
+        tone: [0.0; MAX_TONES],
+        tones: 0,
+    };
+
+    /// The style with weight `weights[m]` on tone `m` (at most [`MAX_TONES`]; missing tones
+    /// weigh 0). Weights must be finite and non-negative; if they sum to more than 1 they are
+    /// divided by their sum, and the neutral tables get what is left of 1.
+    pub fn new(weights: &[f32]) -> Result<Self, StyleError> {
+        if weights.len() > MAX_TONES {
+            return Err(StyleError::TooManyWeights {
+                given: weights.len() as u32,
+                tones: MAX_TONES as u32,
+            });
+        }
+        let mut sum = 0.0f32;
+        for (m, &w) in weights.iter().enumerate() {
+            if !w.is_finite() {
+                return Err(StyleError::NotFinite { tone: m as u32 });
+            }
+            if w < 0.0 {
+                return Err(StyleError::Negative { tone: m as u32 });
+            }
+            sum += w;
+        }
+        let mut st = Self::NEUTRAL;
+        if !sum.is_finite() {
+            // Finite weights whose sum overflows: scale first.
+            let max = weights.iter().fold(0.0f32, |a, &b| a.max(b));
+            let mut s2 = 0.0f32;
+            for (t, &w) in st.tone.iter_mut().zip(weights) {
+                *t = w / max;
+                s2 += *t;
+            }
+            st.tone.iter_mut().for_each(|t| *t /= s2);
+            st.neutral = 0.0;
+        } else if sum > 1.0 {
+            for (t, &w) in st.tone.iter_mut().zip(weights) {
+                *t = w / sum;
+            }
+            st.neutral = 0.0;
+        } else {
+            st.tone[..weights.len()].copy_from_slice(weights);
+            st.neutral = 1.0 - sum;
+        }
+        st.tones = weights.len();
+        if st.tone.iter().all(|&w| w == 0.0) {
+            return Ok(Self::NEUTRAL);
+        }
+        Ok(st)
+    }
+
+    /// The neutral tables' weight.
+    pub fn neutral(&self) -> f32 {
+        self.neutral
+    }
+
+    /// The tones' weights (as many as were given).
+    pub fn weights(&self) -> &[f32] {
+        &self.tone[..self.tones.min(MAX_TONES)]
+    }
+
+    /// Whether only the neutral tables are read.
+    pub fn is_neutral(&self) -> bool {
+        self.tones == 0
+    }
+
+    /// `U(c, s)` mixed with these weights; exactly `t.u(c, s)` when neutral.
+    #[inline]
+    fn u<T: PolicyTables + ?Sized>(&self, t: &T, c: usize, s: usize) -> f32 {
+        if self.is_neutral() {
+            return t.u(c, s);
+        }
+        let mut v = if self.neutral > 0.0 {
+            self.neutral * t.u(c, s)
+        } else {
+            0.0
+        };
+        for (m, &w) in self.weights().iter().enumerate().take(t.tones()) {
+            if w > 0.0 {
+                v += w * t.tone_u(m, c, s);
+            }
+        }
+        v
+    }
+
+    /// `U_cont(e, s)` mixed with these weights; exactly `t.u_cont(e, s)` when neutral.
+    #[inline]
+    fn u_cont<T: PolicyTables + ?Sized>(&self, t: &T, e: usize, s: usize) -> f32 {
+        if self.is_neutral() {
+            return t.u_cont(e, s);
+        }
+        let mut v = if self.neutral > 0.0 {
+            self.neutral * t.u_cont(e, s)
+        } else {
+            0.0
+        };
+        for (m, &w) in self.weights().iter().enumerate().take(t.tones()) {
+            if w > 0.0 {
+                v += w * t.tone_u_cont(m, e, s);
+            }
+        }
+        v
+    }
 }
 
 /// What to do at an exit point.
@@ -226,6 +402,18 @@ pub fn select<T: PolicyTables + ?Sized>(
     b: &[f32],
     penalty: &Penalties,
 ) -> Decision {
+    select_styled(t, e, b, penalty, &Style::NEUTRAL)
+}
+
+/// [`select`] with the value tables mixed by `style` (see the module docs); a style with more
+/// weights than `t` has tones reads only the first `t.tones()`.
+pub fn select_styled<T: PolicyTables + ?Sized>(
+    t: &T,
+    e: usize,
+    b: &[f32],
+    penalty: &Penalties,
+    style: &Style,
+) -> Decision {
     let mut best = Decision {
         exit: e,
         choice: Choice::Continue,
@@ -233,12 +421,12 @@ pub fn select<T: PolicyTables + ?Sized>(
         candidates: 0,
     };
     if !t.exit_is_end(e) {
-        best.cost = dot(t, b, |t, s| t.u_cont(e, s)) + penalty.usage_of(t.exit_segment(e));
+        best.cost = dot(t, b, |t, s| style.u_cont(t, e, s)) + penalty.usage_of(t.exit_segment(e));
         best.candidates = 1;
     }
     for k in 0..t.successor_count(e) {
         let (c, sc) = t.successor(e, k);
-        let v = sc + dot(t, b, |t, s| t.u(c, s)) + penalty.of(c);
+        let v = sc + dot(t, b, |t, s| style.u(t, c, s)) + penalty.of(c);
         best.candidates += 1;
         if v < best.cost {
             best.cost = v;

@@ -58,6 +58,8 @@ const ALL: &[&str] = &[
     "BadJointChannels",
     "BadEndSite",
     "BadDrive",
+    "TooManyTones",
+    "BadToneNames",
 ];
 
 #[test]
@@ -84,7 +86,7 @@ fn every_error_variant_is_reachable() {
     let mut b = good.clone();
     b[0] = b'X';
     check(&b, BlobError::BadMagic);
-    for v in [1u16, 2, FORMAT_VERSION + 1] {
+    for v in [1u16, 2, 4, FORMAT_VERSION + 1] {
         let mut b = good.clone();
         b[4..6].copy_from_slice(&v.to_le_bytes());
         check(&b, BlobError::UnsupportedVersion { found: v });
@@ -128,13 +130,14 @@ fn every_error_variant_is_reachable() {
             section: Section::FrontEnd,
         },
     );
+    // A byte after the last section (`styles`, absent).
     let mut b = good.clone();
     b.push(0);
     fix_crc(&mut b);
     check(
         &b,
         BlobError::Malformed {
-            section: Section::Skeleton,
+            section: Section::Styles,
         },
     );
     let mut b = good.clone();
@@ -618,6 +621,80 @@ fn every_error_variant_is_reachable() {
             s.drives[2] = 1;
         }),
         BlobError::BadDrive { channel: 0 },
+    );
+
+    // Styles: two tones over the tiny policy (2 segments, 3 exits, 2 states) are valid.
+    let st = |f: &dyn Fn(&mut TinyStyles)| {
+        mutated(&|t| {
+            let mut s = TinyStyles::two(4, 6);
+            f(&mut s);
+            t.styles = Some(s);
+        })
+    };
+    let good_styles = st(&|_| {});
+    let b = Blob::parse(&good_styles).unwrap();
+    assert_eq!(b.tones(), 2);
+    assert_eq!(b.tone_names().collect::<Vec<_>>(), ["calm", "lively"]);
+    assert_eq!(b.tone_index("lively"), Some(1));
+    assert_eq!(b.tone_index("neutral"), None);
+    // U^calm(1, 1) is the 4th value (1-based) = 4; U^lively(0, 0) = -1; U_cont^lively(2, 1) =
+    // -6 * 0.5.
+    assert_eq!(
+        (b.tone_u(0, 1, 1), b.tone_u(1, 0, 0), b.tone_u_cont(1, 2, 1)),
+        (4.0, -1.0, -3.0)
+    );
+    assert_eq!(b.tone_u(2, 0, 0), 0.0, "out of range reads 0");
+    assert_eq!(Blob::parse(&good).unwrap().tones(), 0);
+    check(
+        &st(&|s| s.tones = 0),
+        BlobError::ZeroCount {
+            field: Field::Tones,
+        },
+    );
+    check(&st(&|s| s.tones = 9), BlobError::TooManyTones { found: 9 });
+    check(
+        &st(&|s| s.names = "calm".into()),
+        BlobError::BadToneNames { tone: 1 },
+    );
+    check(
+        &st(&|s| s.names = "calm\ncalm".into()),
+        BlobError::BadToneNames { tone: 1 },
+    );
+    check(
+        &st(&|s| s.names = "neutral\nlively".into()),
+        BlobError::BadToneNames { tone: 0 },
+    );
+    check(
+        &st(&|s| s.names = "\nlively".into()),
+        BlobError::BadToneNames { tone: 0 },
+    );
+    check(
+        &st(&|s| s.names = "calm\nlively\nsad".into()),
+        BlobError::BadToneNames { tone: 2 },
+    );
+    check(
+        &st(&|s| {
+            s.u.1.pop();
+        }),
+        BlobError::TableLength {
+            field: Field::ToneU,
+            expected: 16,
+            found: 15,
+        },
+    );
+    check(
+        &st(&|s| s.u_cont.1.extend([0, 0])),
+        BlobError::TableLength {
+            field: Field::ToneUCont,
+            expected: 24,
+            found: 26,
+        },
+    );
+    check(
+        &st(&|s| s.u_cont.0 = f32::NAN),
+        BlobError::NotFinite {
+            field: Field::ToneUCont,
+        },
     );
 
     let all: BTreeSet<&str> = ALL.iter().copied().collect();

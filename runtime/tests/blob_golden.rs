@@ -32,9 +32,17 @@ fn golden_bytes_and_round_trip() {
     assert_eq!(h.payload_len as usize, bytes.len() - HEADER_LEN);
     let sz = blob.section_sizes();
     assert_eq!(
-        sz.front_end + sz.inference + sz.policy + sz.control + sz.library + sz.rig + sz.skeleton,
+        sz.front_end
+            + sz.inference
+            + sz.policy
+            + sz.control
+            + sz.library
+            + sz.rig
+            + sz.skeleton
+            + sz.styles,
         h.payload_len as usize
     );
+    assert_eq!(sz.styles, 1, "an absent styles section is postcard's None");
     assert_eq!(sz.front_end, postcard_len(&tiny.payload().front_end));
     assert_eq!(sz.rig, postcard_len(&tiny.payload().rig));
 

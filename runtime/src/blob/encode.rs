@@ -634,6 +634,57 @@ impl OwnedSkeleton {
     }
 }
 
+/// Owned `styles` section: one pair of value tables per tone (docs/blob-format.md).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OwnedStyles {
+    /// Tones M.
+    pub tones: u8,
+    /// Names joined by `'\n'`.
+    pub names: String,
+    /// U of every tone (M x segments x S), one scale for all tones.
+    pub u: QTable,
+    /// U_cont of every tone (M x exit points x S).
+    pub u_cont: QTable,
+}
+
+impl OwnedStyles {
+    /// The section for tones named `names`, tone `m` having `u[m]` (segments x S,
+    /// segment-major) and `u_cont[m]` (exit points x S; any value at end exits). The tables are
+    /// quantized together, one scale for all tones, so a mix of tones is the mix of their
+    /// stored codes. Names must not contain `'\n'`; the other rules are checked by [`encode`].
+    pub fn new(names: &[&str], u: &[Vec<f64>], u_cont: &[Vec<f64>]) -> Result<Self, EncodeError> {
+        if u.len() != names.len() || u_cont.len() != names.len() {
+            return inconsistent(alloc::format!(
+                "{} tone names for {} U and {} U_cont tables",
+                names.len(),
+                u.len(),
+                u_cont.len()
+            ));
+        }
+        if let Some(n) = names.iter().find(|n| n.contains('\n')) {
+            return inconsistent(alloc::format!("tone name {n:?} contains a line break"));
+        }
+        let flat_u: Vec<f64> = u.iter().flatten().copied().collect();
+        let flat_uc: Vec<f64> = u_cont.iter().flatten().copied().collect();
+        Ok(Self {
+            tones: fit("tones", names.len(), "u8")?,
+            names: names.join("\n"),
+            u: QTable::quantize(&flat_u),
+            u_cont: QTable::quantize(&flat_uc),
+        })
+    }
+
+    /// The wire form, borrowing from `self`.
+    pub fn section(&self) -> StylesSection<'_> {
+        StylesSection {
+            tones: self.tones,
+            names: &self.names,
+            u: self.u.section(),
+            u_cont: self.u_cont.section(),
+        }
+    }
+}
+
 /// Everything a blob holds, owned.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OwnedPayload {
@@ -651,6 +702,8 @@ pub struct OwnedPayload {
     pub rig: OwnedRig,
     /// The library's skeleton (optional, host-side).
     pub skeleton: Option<OwnedSkeleton>,
+    /// Tones (optional).
+    pub styles: Option<OwnedStyles>,
 }
 
 impl OwnedPayload {
@@ -664,6 +717,7 @@ impl OwnedPayload {
             library: self.library.section(),
             rig: self.rig.section(),
             skeleton: self.skeleton.as_ref().map(OwnedSkeleton::section),
+            styles: self.styles.as_ref().map(OwnedStyles::section),
         }
     }
 
@@ -727,6 +781,7 @@ impl OwnedPayload {
                 library,
                 rig,
                 skeleton: None,
+                styles: None,
             },
             _ => unreachable!("the example's fixed tables fit their fields"),
         }

@@ -23,6 +23,8 @@ pub enum Section {
     Rig,
     /// The optional host-side skeleton.
     Skeleton,
+    /// The optional tones (styles).
+    Styles,
 }
 
 impl Section {
@@ -36,6 +38,7 @@ impl Section {
             Self::Library => "library",
             Self::Rig => "rig",
             Self::Skeleton => "skeleton",
+            Self::Styles => "styles",
         }
     }
 }
@@ -131,6 +134,14 @@ pub enum Field {
     EndSites,
     /// `skeleton.drives`.
     Drives,
+    /// `styles.tones`.
+    Tones,
+    /// `styles.names`.
+    ToneNames,
+    /// `styles.u`.
+    ToneU,
+    /// `styles.u_cont`.
+    ToneUCont,
 }
 
 impl Field {
@@ -178,6 +189,10 @@ impl Field {
             Self::Rest => "skeleton.rest",
             Self::EndSites => "skeleton.end_sites",
             Self::Drives => "skeleton.drives",
+            Self::Tones => "styles.tones",
+            Self::ToneNames => "styles.names",
+            Self::ToneU => "styles.u",
+            Self::ToneUCont => "styles.u_cont",
         }
     }
 }
@@ -448,6 +463,19 @@ pub enum BlobError {
         /// Rig channel index.
         channel: u32,
     },
+    // --- styles ---
+    /// More tones than [`MAX_TONES`](crate::policy::MAX_TONES).
+    TooManyTones {
+        /// Tones in the blob.
+        found: u32,
+    },
+    /// `styles.names` does not hold one distinct, non-empty name per tone (or names a tone
+    /// `neutral`, which is the policy's own tables).
+    BadToneNames {
+        /// The first tone whose name is wrong (or the tone count when names are missing or
+        /// extra).
+        tone: u32,
+    },
 }
 
 impl BlobError {
@@ -501,6 +529,8 @@ impl BlobError {
             Self::BadJointChannels { .. } => "BadJointChannels",
             Self::BadEndSite { .. } => "BadEndSite",
             Self::BadDrive { .. } => "BadDrive",
+            Self::TooManyTones { .. } => "TooManyTones",
+            Self::BadToneNames { .. } => "BadToneNames",
         }
     }
 }
@@ -702,6 +732,15 @@ impl fmt::Display for BlobError {
                 f,
                 "skeleton drive of rig channel {channel}: joint, chain top, axis or mode out \
                  of range"
+            ),
+            Self::TooManyTones { found } => write!(
+                f,
+                "{found} tones, the runtime mixes at most {} (pack fewer styles)",
+                crate::policy::MAX_TONES
+            ),
+            Self::BadToneNames { tone } => write!(
+                f,
+                "styles.names: tone {tone} has no name, a repeated one or the reserved                  `neutral` (one distinct name per tone)"
             ),
         }
     }

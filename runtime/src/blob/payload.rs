@@ -34,7 +34,7 @@ pub const DRIVE_RECORD_BYTES: usize = 6;
 pub const ROOT_PARENT: u16 = 0xFFFF;
 
 /// The whole payload: the six device sections in this order, then the optional host-side
-/// skeleton.
+/// skeleton and the optional styles (tones).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Payload<'a> {
     /// Front-end settings.
@@ -56,6 +56,10 @@ pub struct Payload<'a> {
     /// The library's skeleton, for host tools that rebuild BVH motion (the device ignores it).
     #[serde(borrow)]
     pub skeleton: Option<SkeletonSection<'a>>,
+    /// Value tables per tone, mixed at run time with the user's style weights (absent: the
+    /// neutral policy only).
+    #[serde(borrow)]
+    pub styles: Option<StylesSection<'a>>,
 }
 
 /// The prosody front-end's settings ([`ProsodyConfig`], flattened).
@@ -199,6 +203,22 @@ pub struct PolicySection<'a> {
     pub succ: &'a [u8],
     /// Multiplier of the successor costs.
     pub succ_cost_scale: f32,
+}
+
+/// Tones (styles): one pair of value tables per tone, the policy's successor lists shared
+/// (docs/method.md "Style"). The `policy` section's `u` and `u_cont` are the neutral tone.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StylesSection<'a> {
+    /// Tones M (1..=[`MAX_TONES`](crate::policy::MAX_TONES)).
+    pub tones: u8,
+    /// M tone names separated by `'\n'` (non-empty, distinct, none named `neutral`).
+    pub names: &'a str,
+    /// U^m(a', s) of every tone: M x segments x S, tone-major then as `policy.u`.
+    #[serde(borrow)]
+    pub u: I16Section<'a>,
+    /// U_cont^m(e, s) of every tone: M x exit points x S, tone-major then as `policy.u_cont`.
+    #[serde(borrow)]
+    pub u_cont: I16Section<'a>,
 }
 
 /// How the controller runs the policy: when it decides

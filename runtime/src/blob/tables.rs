@@ -37,6 +37,15 @@ impl PolicyTables for Blob<'_> {
     fn successor(&self, e: usize, k: usize) -> (usize, f32) {
         Blob::successor(self, e, k).map_or((0, f32::INFINITY), |s| (s.segment as usize, s.cost))
     }
+    fn tones(&self) -> usize {
+        Blob::tones(self)
+    }
+    fn tone_u(&self, m: usize, c: usize, s: usize) -> f32 {
+        Blob::tone_u(self, m, c, s)
+    }
+    fn tone_u_cont(&self, m: usize, e: usize, s: usize) -> f32 {
+        Blob::tone_u_cont(self, m, e, s)
+    }
 }
 
 impl LibraryFrames for Blob<'_> {

@@ -20,6 +20,8 @@ pub(super) struct Validated<'a> {
     pub crf: CrfWeights<'a>,
     pub u: I16Table<'a>,
     pub u_cont: I16Table<'a>,
+    pub tone_u: I16Table<'a>,
+    pub tone_u_cont: I16Table<'a>,
 }
 
 pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
@@ -32,7 +34,51 @@ pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
     if let Some(sk) = &p.skeleton {
         skeleton(sk, p.library.channels as usize)?;
     }
-    Ok(Validated { crf, u, u_cont })
+    let (tone_u, tone_u_cont) = match &p.styles {
+        Some(st) => styles(st, &p.policy)?,
+        None => (I16Table::EMPTY, I16Table::EMPTY),
+    };
+    Ok(Validated {
+        crf,
+        u,
+        u_cont,
+        tone_u,
+        tone_u_cont,
+    })
+}
+
+/// The styles section: a tone count within the capacity, one distinct non-empty name per tone
+/// (none `neutral`), and value tables of `tones` times the policy's shapes.
+fn styles<'a>(
+    st: &StylesSection<'a>,
+    policy: &PolicySection<'a>,
+) -> Result<(I16Table<'a>, I16Table<'a>), BlobError> {
+    let m = st.tones as usize;
+    count(
+        m,
+        crate::policy::MAX_TONES,
+        Field::Tones,
+        BlobError::TooManyTones { found: m as u32 },
+    )?;
+    let mut names = st.names.split('\n');
+    for k in 0..m {
+        let bad = BlobError::BadToneNames { tone: k as u32 };
+        let name = names.next().ok_or(bad)?;
+        if name.is_empty() || name == "neutral" || st.names.split('\n').take(k).any(|n| n == name) {
+            return Err(bad);
+        }
+    }
+    if names.next().is_some() {
+        return Err(BlobError::BadToneNames { tone: m as u32 });
+    }
+    let s = policy.states as usize;
+    let u = i16_table(Field::ToneU, &st.u, m * policy.segments as usize * s)?;
+    let uc = i16_table(
+        Field::ToneUCont,
+        &st.u_cont,
+        m * policy.exit_points as usize * s,
+    )?;
+    Ok((u, uc))
 }
 
 /// A count in `1..=max`.

@@ -40,6 +40,8 @@ pub struct SectionSizes {
     pub rig: usize,
     /// `skeleton` (1 byte when absent: postcard's `None`).
     pub skeleton: usize,
+    /// `styles` (1 byte when absent).
+    pub styles: usize,
 }
 
 /// An exit point: a frame of a segment where the policy may switch.
@@ -135,6 +137,8 @@ pub struct Blob<'a> {
     crf: CrfWeights<'a>,
     u: I16Table<'a>,
     u_cont: I16Table<'a>,
+    tone_u: I16Table<'a>,
+    tone_u_cont: I16Table<'a>,
 }
 
 impl<'a> Blob<'a> {
@@ -151,6 +155,8 @@ impl<'a> Blob<'a> {
             crf: v.crf,
             u: v.u,
             u_cont: v.u_cont,
+            tone_u: v.tone_u,
+            tone_u_cont: v.tone_u_cont,
         })
     }
 
@@ -507,6 +513,53 @@ impl<'a> Blob<'a> {
     pub fn skeleton(&self) -> Option<SkeletonView<'a>> {
         self.payload.skeleton.map(SkeletonView::new)
     }
+
+    // --- styles ---
+
+    /// Tones in the `styles` section (0 without one).
+    pub fn tones(&self) -> usize {
+        self.payload.styles.map_or(0, |s| s.tones as usize)
+    }
+
+    /// Tone names in order (empty without a `styles` section).
+    pub fn tone_names(&self) -> core::str::Split<'a, char> {
+        let names = match &self.payload.styles {
+            Some(s) => s.names,
+            // An iterator over nothing: `"".split` yields one empty item, so skip it.
+            None => "",
+        };
+        let mut it = names.split('\n');
+        if names.is_empty() {
+            it.next();
+        }
+        it
+    }
+
+    /// The index of the tone named `name` (`None`: no such tone).
+    pub fn tone_index(&self, name: &str) -> Option<usize> {
+        self.tone_names().position(|n| n == name)
+    }
+
+    /// U^m(segment, state) of tone `tone` (0 out of range).
+    #[inline]
+    pub fn tone_u(&self, tone: usize, segment: usize, state: usize) -> f32 {
+        if tone >= self.tones() || segment >= self.segments() || state >= self.states() {
+            return 0.0;
+        }
+        // Bounded by the capacities, so the index arithmetic cannot overflow.
+        self.tone_u
+            .get((tone * self.segments() + segment) * self.states() + state)
+    }
+
+    /// U_cont^m(exit, state) of tone `tone` (0 out of range).
+    #[inline]
+    pub fn tone_u_cont(&self, tone: usize, exit: usize, state: usize) -> f32 {
+        if tone >= self.tones() || exit >= self.exit_points() || state >= self.states() {
+            return 0.0;
+        }
+        self.tone_u_cont
+            .get((tone * self.exit_points() + exit) * self.states() + state)
+    }
 }
 
 /// Decodes the sections one after the other, recording their encoded sizes. Postcard encodes a
@@ -530,9 +583,10 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
     let (library, lib) = take(&mut rest, Section::Library)?;
     let (rig, rg) = take(&mut rest, Section::Rig)?;
     let (skeleton, sk) = take(&mut rest, Section::Skeleton)?;
+    let (styles, st) = take(&mut rest, Section::Styles)?;
     if !rest.is_empty() {
         return Err(BlobError::Malformed {
-            section: Section::Skeleton,
+            section: Section::Styles,
         });
     }
     Ok((
@@ -544,6 +598,7 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
             library,
             rig,
             skeleton,
+            styles,
         },
         SectionSizes {
             front_end: fe,
@@ -553,6 +608,7 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
             library: lib,
             rig: rg,
             skeleton: sk,
+            styles: st,
         },
     ))
 }

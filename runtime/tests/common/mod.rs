@@ -72,6 +72,51 @@ pub struct Tiny {
     pub calibration: Vec<u8>,
     pub channel_names: String,
     pub skeleton: Option<TinySkeleton>,
+    /// Tones: count, names, U (scale, bytes), U_cont (scale, bytes).
+    pub styles: Option<TinyStyles>,
+}
+
+/// The tiny blob's tones (none by default; [`TinyStyles::two`] gives two).
+#[derive(Clone, Debug)]
+pub struct TinyStyles {
+    pub tones: u8,
+    pub names: String,
+    pub u: (f32, Vec<u8>),
+    pub u_cont: (f32, Vec<u8>),
+}
+
+impl TinyStyles {
+    /// Two tones `calm` and `lively` with `u_len` values of U and `u_cont_len` of U_cont
+    /// each: U^calm = 1, 2, ..., U^lively the negatives (scale 1); U_cont likewise (scale 0.5).
+    pub fn two(u_len: usize, u_cont_len: usize) -> Self {
+        let codes = |n: usize| -> Vec<u8> {
+            (1..=n as i16)
+                .chain((1..=n as i16).map(|v| -v))
+                .flat_map(|v| v.to_le_bytes())
+                .collect()
+        };
+        Self {
+            tones: 2,
+            names: "calm\nlively".into(),
+            u: (1.0, codes(u_len)),
+            u_cont: (0.5, codes(u_cont_len)),
+        }
+    }
+
+    pub fn section(&self) -> StylesSection<'_> {
+        StylesSection {
+            tones: self.tones,
+            names: &self.names,
+            u: I16Section {
+                scale: self.u.0,
+                bytes: &self.u.1,
+            },
+            u_cont: I16Section {
+                scale: self.u_cont.0,
+                bytes: &self.u_cont.1,
+            },
+        }
+    }
 }
 
 /// The tiny blob's skeleton: `hips` (6 channels) with child `head` (3 rotations, an end site);
@@ -180,6 +225,7 @@ impl Tiny {
             calibration: calibration_record(&ChannelCal::HOBBY).to_vec(),
             channel_names: "head".into(),
             skeleton: Some(TinySkeleton::new()),
+            styles: None,
         }
     }
 
@@ -236,6 +282,7 @@ impl Tiny {
                 channel_names: &self.channel_names,
             },
             skeleton: self.skeleton.as_ref().map(TinySkeleton::section),
+            styles: self.styles.as_ref().map(TinyStyles::section),
         }
     }
 
@@ -270,28 +317,28 @@ pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-/// The tiny blob's bytes (format version 4: the `control` section after
+/// The tiny blob's bytes (format version 5: `styles` absent, the final `00`; the `control`
+/// section after
 /// `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601`; the
 /// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4) and no `groups`,
 /// `00`). Changing the format changes
 /// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(
-    "4753544204000000ca010000699bff2a",
-    "807d00009642000016448fc2f53c6666e63e0ad7233c3333b33e295c0f3e0000",
-    "00400000c8410000c84100008c42061902010134000000bf000080bf0000803e",
-    "0000c0bf000000400000003f000080400000a0bf0000003e0000003f000080be",
-    "000000410000c03f0ad7233c0464009cff6f12833a08e80300000000e8036f12",
-    "033b04f4010cfe0202036666663f0000003f080a0014001e0028000000803e0c",
-    "0100020003000400050006000c00000200010001000100020010000000000200",
-    "0000020000000400000010000005000100fbff0000070001000000cdcccc3d01",
-    "32ac020000c03f882700008040b0ea01fa019601010000f04106020800000000",
-    "030000000403000300080ad7233c000020410c00006400c8002c019cff38ff04",
-    "ffff01000200020201000112000474696e7900409c461c000000000000b4c200",
-    "00b4420000803f0080bb440000204100007a430468656164010209686970730a",
-    "6865616404ffff00001800000000000000000000000000000000000020410000",
-    "00000206030900010205030405030424000000000000b4420000000000000000",
-    "00000000000000000000000000000000000000000e0100000000000000a04000",
-    "00000006010001000101",
+    "4753544205000000cb010000eac946e6807d00009642000016448fc2f53c6666",
+    "e63e0ad7233c3333b33e295c0f3e000000400000c8410000c84100008c420619",
+    "02010134000000bf000080bf0000803e0000c0bf000000400000003f00008040",
+    "0000a0bf0000003e0000003f000080be000000410000c03f0ad7233c0464009c",
+    "ff6f12833a08e80300000000e8036f12033b04f4010cfe0202036666663f0000",
+    "003f080a0014001e0028000000803e0c0100020003000400050006000c000002",
+    "0001000100010002001000000000020000000200000004000000100000050001",
+    "00fbff0000070001000000cdcccc3d0132ac020000c03f882700008040b0ea01",
+    "fa019601010000f04106020800000000030000000403000300080ad7233c0000",
+    "20410c00006400c8002c019cff38ff04ffff0100020002020100011200047469",
+    "6e7900409c461c000000000000b4c20000b4420000803f0080bb440000204100",
+    "007a430468656164010209686970730a6865616404ffff000018000000000000",
+    "0000000000000000000000002041000000000206030900010205030405030424",
+    "000000000000b442000000000000000000000000000000000000000000000000",
+    "000000000e0100000000000000a040000000000601000100010100",
 );
 
 pub fn postcard_len<T: serde::Serialize>(v: &T) -> usize {

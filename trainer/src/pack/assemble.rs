@@ -181,6 +181,7 @@ pub fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, Encod
         library: parts.library.section(),
         rig: parts.rig.section(),
         skeleton: parts.skeleton.as_ref().map(OwnedSkeleton::section),
+        styles: None,
     })
 }
 
