@@ -18,6 +18,7 @@ use clap::{Parser, Subcommand};
 use crate::error::SimError;
 use crate::live::{self, LiveOptions};
 use crate::run::{self as run_cmd, RunConfig, RunError};
+use crate::style::StyleFlags;
 use crate::{bench, eval_cmd, prosody_cmd};
 
 /// Runs the gesture-controller runtime on the desktop.
@@ -98,6 +99,9 @@ pub enum Command {
         /// motion and its speech as one scene.
         #[arg(long)]
         blender: bool,
+        /// The style (tones of the blob).
+        #[command(flatten)]
+        style: StyleFlags,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
     /// utterance, and `run` on it (a few seconds after the build).
@@ -151,6 +155,9 @@ pub enum Command {
         /// Humanoid bone map for --vmc (overrides the built-in aliases).
         #[arg(long, value_name = "FILE", requires = "vmc")]
         bone_map: Option<PathBuf>,
+        /// The style (tones of the blob); a style track's times count from the start.
+        #[command(flatten)]
+        style: StyleFlags,
     },
 }
 
@@ -200,6 +207,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             vmc,
             bone_map,
             blender,
+            style,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -212,6 +220,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 vmc: vmc.clone(),
                 bone_map: bone_map.clone(),
                 blender: *blender,
+                style: style.clone(),
             },
             out,
         ),
@@ -231,6 +240,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             seconds,
             vmc,
             bone_map,
+            style,
         } => {
             let bytes = run_cmd::read_blob(blob)?;
             let b =
@@ -238,6 +248,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                     path: blob.clone(),
                     source,
                 })?;
+            let tones: Vec<&str> = b.tone_names().collect();
+            let styles = style.schedule(&tones).map_err(RunError::Style)?;
             let mut sender = match vmc {
                 Some(addr) => Some(run_cmd::vmc_sender(&b, addr, bone_map.as_deref())?),
                 None => None,
@@ -246,6 +258,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             let opts = LiveOptions {
                 seconds: *seconds,
                 redraw: io::IsTerminal::is_terminal(&io::stdout()),
+                styles,
             };
             live::live_loop_with(
                 &b,

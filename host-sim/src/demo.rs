@@ -229,6 +229,7 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
             vmc: None,
             bone_map: None,
             blender: false,
+            style: Default::default(),
         };
         line(
             out,

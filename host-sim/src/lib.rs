@@ -40,4 +40,5 @@ pub mod prosody_cmd;
 pub mod run;
 pub mod servo;
 pub mod soak;
+pub mod style;
 pub mod vmc;

@@ -157,12 +157,15 @@ pub fn belief_bar(b: &[f32]) -> String {
 }
 
 /// Settings of the live loop.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct LiveOptions {
     /// Stop after this much audio (s); `None`: until the source ends.
     pub seconds: Option<f64>,
     /// Redraw one belief line in place (`\r`, for a terminal) instead of one line per step.
     pub redraw: bool,
+    /// Style changes (times from the start of listening; `--style`, `--energy`,
+    /// `--style-track`), each given to the controller when the audio reaches it.
+    pub styles: Vec<crate::style::StyleChange>,
 }
 
 /// What a live session did.
@@ -234,7 +237,31 @@ pub fn live_loop_with(
         blob.states(),
         blob.segments()
     )?;
+    let tones: Vec<&str> = blob.tone_names().collect();
+    let mut next_style = 0usize;
     loop {
+        while let Some(c) = opts.styles.get(next_style) {
+            if c.time_s * rate as f64 > fed as f64 {
+                break;
+            }
+            device
+                .controller_mut()
+                .set_style(&c.weights)
+                .map_err(|e| LiveError::Backend(format!("style: {e}")))?;
+            if next_style > 0 || c.weights.iter().any(|&w| w > 0.0) {
+                let d: Vec<String> = crate::style::describe(&c.weights, &tones)
+                    .iter()
+                    .map(|(n, w)| format!("{n}={w:.2}"))
+                    .collect();
+                writeln!(
+                    out,
+                    "{:7.2} s  style {}",
+                    fed as f64 / rate as f64,
+                    d.join(",")
+                )?;
+            }
+            next_style += 1;
+        }
         raw.clear();
         let more = source.read(&mut raw, Duration::from_millis(200))?;
         resampled.clear();

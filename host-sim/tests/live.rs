@@ -83,6 +83,7 @@ fn live_loop_runs_a_fake_microphone() {
     let opts = LiveOptions {
         seconds: Some(2.0),
         redraw: true,
+        ..Default::default()
     };
     let stats = live_loop(&blob, &mut src, opts, &mut Vec::new()).unwrap();
     assert!((stats.seconds - 2.0).abs() < 1e-9, "{stats:?}");

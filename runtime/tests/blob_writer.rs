@@ -113,6 +113,18 @@ fn constructors_round_trip_through_the_reader() {
         library,
         rig,
         skeleton: None,
+        // Two tones over 4 segments, 8 exits and 3 states; one scale for both.
+        styles: Some(
+            OwnedStyles::new(
+                &["calm", "lively"],
+                &[
+                    (0..12).map(|v| v as f64).collect(),
+                    (0..12).map(|v| -2.0 * v as f64).collect(),
+                ],
+                &[vec![0.5; 24], vec![-0.5; 24]],
+            )
+            .unwrap(),
+        ),
     };
     let bytes = owned.encode().unwrap();
     let b = Blob::parse(&bytes).unwrap();
@@ -156,6 +168,14 @@ fn constructors_round_trip_through_the_reader() {
     assert_eq!(b.channel_names().collect::<Vec<_>>(), names);
     assert_eq!(b.rig_name(), "puppet");
     assert_eq!(b.fps(), 25.0);
+    // Tones: U^calm(3, 2) = 11, U^lively(3, 2) = -22 (the scale is 22 / 32767 for both).
+    assert_eq!(b.tone_names().collect::<Vec<_>>(), ["calm", "lively"]);
+    near(b.tone_u(0, 3, 2), 11.0, 22.0);
+    near(b.tone_u(1, 3, 2), -22.0, 22.0);
+    near(b.tone_u_cont(1, 7, 1), -0.5, 0.5);
+    // A line break in a name, or tables that do not match the names, are refused.
+    assert!(OwnedStyles::new(&["a\nb"], &[vec![]], &[vec![]]).is_err());
+    assert!(OwnedStyles::new(&["a", "b"], &[vec![]], &[vec![]]).is_err());
 }
 
 #[test]

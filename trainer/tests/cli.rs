@@ -322,3 +322,69 @@ fn outputs_never_overwrite_inputs() {
         );
     }
 }
+
+/// `pack`'s tone options: every mistake is one line, exit 2, before anything is read or written.
+#[test]
+fn bad_style_options_are_refused_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let clip = dir.path().join("a_active_1.bvh");
+    std::fs::write(&clip, "not read: the options fail first").unwrap();
+    let clip = clip.to_str().unwrap().to_string();
+    let out = dir.path().join("x.blob");
+    let nothing = format!("active={}/*_sad_*.bvh", dir.path().display());
+    let active = format!("active={clip}");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["--style-neutral", &clip, "--style", &nothing],
+            "matches no .bvh file",
+        ),
+        (
+            vec!["--style-neutral", &clip, "--style", "neutral=x"],
+            "cannot name a tone",
+        ),
+        (
+            vec!["--style-neutral", &clip, "--style", "a b=x"],
+            "cannot name a tone",
+        ),
+        (
+            vec!["--style-neutral", &clip, "--style", "active"],
+            "expected NAME=PATTERN",
+        ),
+        (vec!["--style", &active], "needs neutral motion"),
+        (vec!["--style-neutral", &clip], "nothing to compare"),
+        (
+            vec![
+                "--style-neutral",
+                &clip,
+                "--style",
+                &active,
+                "--style",
+                &active,
+            ],
+            "given twice",
+        ),
+        (
+            vec!["--style-neutral", "/no/such/dir", "--style", &active],
+            "no such file",
+        ),
+        (vec!["--energy", "0.5"], "--energy"),
+    ];
+    for (extra, want) in cases {
+        let mut args = vec![
+            "pack",
+            "--model",
+            "/no/model.json",
+            "--library",
+            &clip,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra.iter().copied());
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
+        assert!(err.contains(want), "{extra:?}: {want:?} not in {err}");
+        assert!(!out.exists());
+    }
+}

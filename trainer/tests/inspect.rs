@@ -45,7 +45,7 @@ fn summarizes_a_valid_blob() {
     let text = String::from_utf8(out.stdout).unwrap();
     for want in [
         format!(
-            "blob: {n} bytes, format version 4, flags 0x0000, payload {} bytes",
+            "blob: {n} bytes, format version 5, flags 0x0000, payload {} bytes",
             n - 16
         ),
         "sections (bytes): front_end ".to_string(),
@@ -63,6 +63,7 @@ fn summarizes_a_valid_blob() {
          stroke, 1 labelled, 0 run on into their recorded successor, 0 rotation groups"
             .to_string(),
         "rig: \"example\", PWM period 20000 us, 1 channels: head".to_string(),
+        "styles: none (neutral only)".to_string(),
     ] {
         assert!(text.contains(&want), "missing {want:?} in\n{text}");
     }

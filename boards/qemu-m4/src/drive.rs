@@ -25,6 +25,12 @@
 //! recording pins) must stay within the 500..=2500 us pulse range. A violation stops the run
 //! with [`RunError::Pose`].
 //!
+//! ## Style
+//!
+//! A blob with tones runs with every tone and neutral weighted alike (`1 / (M + 1)` each): the
+//! dearest mix, every value table read at every candidate, so the measured cost is the worst a
+//! style can make it. `check` gives `gesture-sim run` the same `--style`.
+//!
 //! `no_std`, no heap: the device and the DMA buffer are on the caller's stack.
 
 use core::convert::Infallible;
@@ -74,6 +80,8 @@ pub enum RunError {
         /// The animation tick.
         tick: u64,
     },
+    /// The controller refused the style (a blob with more tones than a style holds).
+    Style,
     /// Writing the trace failed.
     Output,
 }
@@ -92,6 +100,7 @@ impl RunError {
             Self::Device(DeviceError::Rig(_)) => "Rig",
             Self::OddAudio { .. } => "OddAudio",
             Self::Pose { .. } => "Pose",
+            Self::Style => "Style",
             Self::Output => "Output",
         }
     }
@@ -112,6 +121,7 @@ impl fmt::Display for RunError {
             Self::Device(e) => write!(f, "device: {e}"),
             Self::OddAudio { len } => write!(f, "audio is {len} bytes, not whole i16 samples"),
             Self::Pose { tick } => write!(f, "invalid pose or servo pulse at tick {tick}"),
+            Self::Style => f.write_str("the controller refused the style"),
             Self::Output => f.write_str("writing the trace failed"),
         }
     }
@@ -232,6 +242,15 @@ pub fn run(
 
     let mut slot = None;
     let controller = build(&mut slot, &blob).map_err(RunError::Device)?;
+    let tones = blob.tones();
+    if tones > 0 {
+        let mut w = [0.0f32; gesture_runtime::policy::MAX_TONES];
+        let share = 1.0 / (tones as f32 + 1.0);
+        w[..tones].iter_mut().for_each(|v| *v = share);
+        controller
+            .set_style(&w[..tones])
+            .map_err(|_| RunError::Style)?;
+    }
     let mut device: BoardDevice<'_, '_> =
         Device::new(controller, [RecordingPin::default(); CHANNELS]).map_err(RunError::Device)?;
     probe.ready();

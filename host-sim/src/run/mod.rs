@@ -73,6 +73,8 @@ pub struct RunConfig {
     pub bone_map: Option<PathBuf>,
     /// Also write `blender.py` and `speech.wav` ([`blender`]).
     pub blender: bool,
+    /// The style and its changes over time ([`crate::style`]).
+    pub style: crate::style::StyleFlags,
 }
 
 /// Why `run` failed.
@@ -108,6 +110,9 @@ pub enum RunError {
     /// The audio file could not be loaded.
     #[error(transparent)]
     Audio(#[from] AudioError),
+    /// The style options do not fit the blob.
+    #[error("{0}")]
+    Style(String),
     /// The output path exists and is not a folder.
     #[error("{}: exists and is not a folder (give a folder for the outputs)", path.display())]
     OutNotDir {
@@ -154,6 +159,7 @@ impl RunError {
             | Self::RigMismatch { .. }
             | Self::Audio(_)
             | Self::OutNotDir { .. }
+            | Self::Style(_)
             | Self::Overwrite(_) => 2,
             Self::Sim(_) | Self::Render { .. } | Self::Write { .. } => 1,
         }
@@ -362,6 +368,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     let mut inputs: Vec<&Path> = vec![&cfg.blob, &cfg.audio];
     inputs.extend(cfg.rig.as_deref());
     inputs.extend(cfg.bone_map.as_deref());
+    inputs.extend(cfg.style.style_track.as_deref());
     gesture_trainer::output::refuse_inputs(&outputs, &inputs).map_err(RunError::from)?;
     let bytes = read_blob(&cfg.blob)?;
     let blob = Blob::parse(&bytes).map_err(|source| RunError::Blob {
@@ -369,6 +376,8 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         source,
     })?;
     let (cals, period_us) = calibrations(&blob, &cfg.blob, cfg.rig.as_deref())?;
+    let tones: Vec<&str> = blob.tone_names().collect();
+    let styles = cfg.style.schedule(&tones).map_err(RunError::Style)?;
     let rate = blob.prosody_config().sample_rate_hz;
     let pcm = load_wav_at(&cfg.audio, rate).map_err(RunError::from)?;
     let mut vmc = match &cfg.vmc {
@@ -386,6 +395,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
             // With --vmc the poses are paced as they are sent instead.
             realtime: cfg.realtime && vmc.is_none(),
         },
+        &styles,
     )
     .map_err(RunError::Sim)?;
     let audio_name = cfg.audio.display().to_string();
@@ -405,6 +415,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
                 |s| blob.continues(s),
                 |s| blob.segment(s).map_or(1, |x| x.len as usize),
             ),
+            tones: &tones,
         },
         &pcm.samples,
         cfg.video.then_some(cfg.audio.as_path()),

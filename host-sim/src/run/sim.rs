@@ -22,6 +22,7 @@ use gesture_runtime::prosody::StepKind;
 use gesture_runtime::rig::{ChannelCal, MAX_CHANNELS};
 
 use crate::servo::VirtualPin;
+use crate::style::StyleChange;
 
 /// One prosody frame (10 ms).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,6 +86,8 @@ pub struct DecisionRecord {
     pub candidates: usize,
     /// Expected cost of the choice.
     pub cost: f32,
+    /// The style in force (index into [`Simulation::styles`]).
+    pub style: usize,
 }
 
 /// Everything a run produced.
@@ -110,6 +113,8 @@ pub struct Simulation {
     pub duties: Vec<Vec<u16>>,
     /// Wall-clock time of the simulation (s).
     pub wall_s: f64,
+    /// The style changes applied, in time order (the first at time 0; neutral if none given).
+    pub styles: Vec<StyleChange>,
 }
 
 impl Simulation {
@@ -121,6 +126,14 @@ impl Simulation {
             .filter(|s| s.kind == StepKind::Syllable && !s.flushed)
             .map(StepRecord::latency_s)
             .collect()
+    }
+
+    /// The tone weights in force at `decision` (index into `decisions`).
+    pub fn style_at(&self, decision: usize) -> &[f32] {
+        self.decisions
+            .get(decision)
+            .and_then(|d| self.styles.get(d.style))
+            .map_or(&[], |s| &s.weights)
     }
 
     /// Audio seconds per wall-clock second.
@@ -154,15 +167,46 @@ pub struct SimOptions {
     pub realtime: bool,
 }
 
+/// Splits `samples` into chunks of `chunk`, and also at every sample index in `cuts` (sorted):
+/// `(start, end)` ranges.
+fn chunk_ranges(len: usize, chunk: usize, cuts: &[usize]) -> Vec<(usize, usize)> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    let mut cut = cuts
+        .iter()
+        .copied()
+        .filter(|&c| c > 0 && c < len)
+        .peekable();
+    while start < len {
+        let mut end = (start + chunk.max(1)).min(len);
+        while let Some(&c) = cut.peek() {
+            if c <= start {
+                cut.next();
+            } else {
+                if c < end {
+                    end = c;
+                }
+                break;
+            }
+        }
+        out.push((start, end));
+        start = end;
+    }
+    out
+}
+
 /// Runs `samples` (at the blob's rate) through the device loop of `blob` (the runtime's
 /// [`Device`]: its controller and its servo rig on virtual pins), with servo calibrations
-/// `cals` and PWM period `period_us`.
+/// `cals` and PWM period `period_us`. Each of `styles` (time order) is given to the controller
+/// when the audio reaches its time (chunks are split there, which changes nothing else: the
+/// controller's output does not depend on the chunking); none: neutral throughout.
 pub fn simulate(
     blob: &Blob<'_>,
     samples: &[i16],
     cals: &[ChannelCal],
     period_us: f32,
     opts: SimOptions,
+    styles: &[StyleChange],
 ) -> Result<Simulation, String> {
     let mut slot = Box::new(None);
     let controller = BlobController::from_blob_in(&mut slot, blob).map_err(|e| e.to_string())?;
@@ -180,9 +224,23 @@ pub fn simulate(
         ..Simulation::default()
     };
     let channels = blob.channels();
+    let at = |c: &StyleChange| (c.time_s * rate as f64).round().max(0.0) as usize;
+    let cuts: Vec<usize> = styles.iter().map(at).collect();
+    let mut next_style = 0usize;
+    let mut style = 0usize;
     let start = Instant::now();
     let mut pushed = 0usize;
-    for chunk in samples.chunks(opts.chunk.max(1)) {
+    for (a, b) in chunk_ranges(samples.len(), opts.chunk, &cuts) {
+        while next_style < styles.len() && at(&styles[next_style]) <= a {
+            device
+                .controller_mut()
+                .set_style(&styles[next_style].weights)
+                .map_err(|e| format!("style at {:.3} s: {e}", styles[next_style].time_s))?;
+            sim.styles.push(styles[next_style].clone());
+            style = sim.styles.len() - 1;
+            next_style += 1;
+        }
+        let chunk = &samples[a..b];
         pushed += chunk.len();
         let now_s = pushed as f64 / rate as f64;
         if opts.realtime {
@@ -193,11 +251,17 @@ pub fn simulate(
         }
         // Virtual pins cannot fail.
         let _ = device.push(chunk, &mut |e| {
-            record(&mut sim, blob, channels, now_s, false, e)
+            record(&mut sim, blob, channels, now_s, false, style, e)
         });
     }
     let now_s = pushed as f64 / rate as f64;
-    let _ = device.finish(&mut |e| record(&mut sim, blob, channels, now_s, true, e));
+    let _ = device.finish(&mut |e| record(&mut sim, blob, channels, now_s, true, style, e));
+    if sim.styles.is_empty() {
+        sim.styles.push(StyleChange {
+            time_s: 0.0,
+            weights: vec![0.0; blob.tones()],
+        });
+    }
     sim.wall_s = start.elapsed().as_secs_f64();
     Ok(sim)
 }
@@ -210,6 +274,7 @@ fn record(
     channels: usize,
     now_s: f64,
     flushed: bool,
+    style: usize,
     e: DeviceEvent<'_, VirtualPin, MAX_CHANNELS>,
 ) {
     let fps = sim.fps;
@@ -256,6 +321,7 @@ fn record(
                 },
                 candidates: decision.candidates,
                 cost: decision.cost,
+                style,
             })
         }
         ControllerEvent::Pose {
@@ -268,5 +334,21 @@ fn record(
             sim.shown.push((segment, frame));
         }
         ControllerEvent::Onset(_) => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_are_split_at_style_changes() {
+        assert_eq!(
+            chunk_ranges(10, 4, &[0, 6, 8, 20]),
+            [(0, 4), (4, 6), (6, 8), (8, 10)]
+        );
+        assert_eq!(chunk_ranges(5, 10, &[]), [(0, 5)]);
+        assert_eq!(chunk_ranges(0, 10, &[3]), []);
+        assert_eq!(chunk_ranges(6, 3, &[3, 3]), [(0, 3), (3, 6)]);
     }
 }

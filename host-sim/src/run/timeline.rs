@@ -1,7 +1,7 @@
 //! `timeline.json`: what the controller heard, believed and chose, in time order.
 //!
 //! ```text
-//! { "format": "gesture-sim-timeline", "version": 2,
+//! { "format": "gesture-sim-timeline", "version": 3,
 //!   "audio": PATH, "blob": PATH, "sample_rate_hz", "fps", "duration_s", "ticks",
 //!   "states", "segments", "exit_points", "chunk_s",
 //!   "steps": [ { "kind": "syllable" | "pause", "start_s", "end_s", "f0_hz" (null when
@@ -9,7 +9,8 @@
 //!                when "flushed"), "flushed", "belief": [S numbers] } ],
 //!   "decisions": [ { "time_s", "tick", "exit", "exit_segment", "exit_frame",
 //!                    "choice": "continue" | "enter", "segment" (entered, or null),
-//!                    "candidates", "cost" } ],
+//!                    "candidates", "cost", "style": { NAME: WEIGHT } } ],
+//!   "tones": [NAME...], "styles": [ { "time_s", "style": { NAME: WEIGHT } } ],
 //!   "entries": [ { "tick", "time_s", "segment", "cut" } ],
 //!   "latency": { "syllables", "median_s", "max_s" } }
 //! ```
@@ -21,10 +22,14 @@
 //! is over the syllables that are not flushed. `entries` are the segment entries as shown
 //! (a new segment, or one started over): `cut` unless the body moved on from a segment's last
 //! frame into its recorded successor; `gesture-sim metrics` reads them with `motion.bvh`.
+//! `style` is the style in force at a decision: `neutral` and every tone with a weight above 0
+//! (the weights sum to 1); `styles` lists the changes given (`--style`, `--style-track`,
+//! `--energy`), the first at time 0; `tones` the blob's tones (empty for a blob without).
 
 use serde::Serialize;
 
 use super::sim::{median_max, Simulation};
+use crate::style::describe;
 use gesture_runtime::prosody::StepKind;
 use gesture_trainer::evaluate::metrics::Entry;
 
@@ -45,8 +50,19 @@ pub struct Timeline<'a> {
     chunk_s: f64,
     steps: Vec<Step>,
     decisions: Vec<Decision>,
+    tones: Vec<String>,
+    styles: Vec<StyleRecord>,
     entries: Vec<EntryRecord>,
     latency: Latency,
+}
+
+/// A style as written: name to weight, `neutral` included.
+type StyleMap = std::collections::BTreeMap<String, f32>;
+
+#[derive(Debug, Serialize)]
+struct StyleRecord {
+    time_s: f64,
+    style: StyleMap,
 }
 
 /// One segment entry as written.
@@ -87,6 +103,7 @@ struct Decision {
     segment: Option<usize>,
     candidates: usize,
     cost: f32,
+    style: StyleMap,
 }
 
 #[derive(Debug, Serialize)]
@@ -113,6 +130,8 @@ pub struct Context<'a> {
     pub chunk_s: f64,
     /// Segment entries.
     pub entries: &'a [Entry],
+    /// The blob's tone names.
+    pub tones: &'a [&'a str],
 }
 
 /// Rounds to 6 decimals so the file stays readable (microsecond times).
@@ -127,7 +146,7 @@ impl<'a> Timeline<'a> {
         let mm = median_max(&lat);
         Self {
             format: "gesture-sim-timeline",
-            version: 2,
+            version: 3,
             audio: cx.audio,
             blob: cx.blob,
             sample_rate_hz: sim.sample_rate_hz,
@@ -157,10 +176,20 @@ impl<'a> Timeline<'a> {
                     belief: s.belief.clone(),
                 })
                 .collect(),
+            tones: cx.tones.iter().map(|t| t.to_string()).collect(),
+            styles: sim
+                .styles
+                .iter()
+                .map(|c| StyleRecord {
+                    time_s: r6(c.time_s),
+                    style: describe(&c.weights, cx.tones).into_iter().collect(),
+                })
+                .collect(),
             decisions: sim
                 .decisions
                 .iter()
-                .map(|d| Decision {
+                .enumerate()
+                .map(|(k, d)| Decision {
                     time_s: r6(d.time_s),
                     tick: d.tick,
                     exit: d.exit,
@@ -174,6 +203,7 @@ impl<'a> Timeline<'a> {
                     segment: d.entered,
                     candidates: d.candidates,
                     cost: d.cost,
+                    style: describe(sim.style_at(k), cx.tones).into_iter().collect(),
                 })
                 .collect(),
             entries: cx

@@ -284,3 +284,110 @@ impl DeviceArgs {
         opts.plant_feet = !self.free_legs;
     }
 }
+
+/// Tones to pack (`pack`, `eval-motion`; docs/method.md "Style control").
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct StyleArgs {
+    /// Neutral motion the tones are compared with: BVH files, folders or path patterns (e.g.
+    /// `'bandai/*_normal_*.bvh'`).
+    #[arg(long, num_args = 1.., value_name = "FILES")]
+    pub style_neutral: Vec<String>,
+    /// A tone and the motion that shows it, as NAME=PATTERN (a BVH file, a folder or a path
+    /// pattern such as `'active=bandai/*_active_*.bvh'`); repeatable. Names: letters, digits,
+    /// `-` and `_`.
+    #[arg(long = "style", value_name = "NAME=PATTERN")]
+    pub style: Vec<String>,
+    /// Add the energy knob: tones `energetic` and `calm`, the same motion FACTOR times larger
+    /// or smaller (path length, speed, acceleration), no motion data needed.
+    #[arg(long, num_args = 0..=1, default_missing_value = "1.5", value_name = "FACTOR",
+          value_parser = |s: &str| bounded(s, 1.01, 10.0))]
+    pub energy: Option<f64>,
+}
+
+/// Whether `name` can name a tone: 1-32 letters, digits, `-` or `_`, and not `neutral` (the
+/// policy's own tables).
+pub fn tone_name_ok(name: &str) -> bool {
+    (1..=32).contains(&name.len())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        && name != "neutral"
+}
+
+/// The BVH files a command-line path or pattern names (`flag` for the error): a file, the
+/// BVH files under a folder, or the files a pattern with `*`, `?` or `[` matches.
+pub fn bvh_files(flag: &str, pattern: &str) -> Result<Vec<std::path::PathBuf>, CliError> {
+    let is_bvh = |p: &std::path::Path| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("bvh"));
+    let mut out: Vec<std::path::PathBuf> = if pattern.contains(['*', '?', '[']) {
+        glob::glob(pattern)
+            .map_err(|e| CliError::Input(format!("{flag} {pattern}: bad pattern: {e}")))?
+            .filter_map(Result::ok)
+            .filter(|p| p.is_file() && is_bvh(p))
+            .collect()
+    } else {
+        let p = std::path::PathBuf::from(pattern);
+        if !p.exists() {
+            return Err(CliError::Input(format!(
+                "{flag} {pattern}: no such file or folder"
+            )));
+        }
+        crate::corpus::discover(&[p])
+            .map_err(|e| CliError::Input(format!("{flag} {pattern}: {e}")))?
+            .into_iter()
+            .filter_map(|t| t.bvh)
+            .collect()
+    };
+    out.sort();
+    if out.is_empty() {
+        return Err(CliError::Input(format!(
+            "{flag} {pattern}: matches no .bvh file"
+        )));
+    }
+    Ok(out)
+}
+
+impl StyleArgs {
+    /// The tones to pack, every pattern expanded and every name checked.
+    pub fn options(&self) -> Result<crate::pack::StyleOptions, CliError> {
+        let mut o = crate::pack::StyleOptions {
+            energy: self.energy,
+            ..Default::default()
+        };
+        for p in &self.style_neutral {
+            o.neutral.extend(bvh_files("--style-neutral", p)?);
+        }
+        for spec in &self.style {
+            let (name, pattern) = spec.split_once('=').ok_or_else(|| {
+                CliError::Input(format!(
+                    "--style {spec}: expected NAME=PATTERN (e.g. 'active=clips/*_active_*.bvh')"
+                ))
+            })?;
+            if !tone_name_ok(name) {
+                return Err(CliError::Input(format!(
+                    "--style {spec}: `{name}` cannot name a tone (1-32 letters, digits, - or _; \
+                     not `neutral`)"
+                )));
+            }
+            if o.tones.iter().any(|(n, _)| n == name) {
+                return Err(CliError::Input(format!(
+                    "--style {spec}: the tone `{name}` is given twice"
+                )));
+            }
+            o.tones.push((
+                name.to_string(),
+                bvh_files(&format!("--style {name}="), pattern)?,
+            ));
+        }
+        if !o.tones.is_empty() && o.neutral.is_empty() {
+            return Err(CliError::Input(
+                "--style needs neutral motion to compare with: add --style-neutral FILES".into(),
+            ));
+        }
+        if o.tones.is_empty() && !o.neutral.is_empty() {
+            return Err(CliError::Input(
+                "--style-neutral without any --style NAME=PATTERN: nothing to compare".into(),
+            ));
+        }
+        Ok(o)
+    }
+}

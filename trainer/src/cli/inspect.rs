@@ -39,8 +39,8 @@ pub fn summary(b: &Blob<'_>) -> String {
     let _ = writeln!(
         s,
         "sections (bytes): front_end {}, inference {}, policy {}, control {}, library {}, rig {}, \
-         skeleton {}",
-        z.front_end, z.inference, z.policy, z.control, z.library, z.rig, z.skeleton
+         skeleton {}, styles {}",
+        z.front_end, z.inference, z.policy, z.control, z.library, z.rig, z.skeleton, z.styles
     );
     let c = b.prosody_config();
     let _ = writeln!(
@@ -145,6 +145,17 @@ pub fn summary(b: &Blob<'_>) -> String {
         None => {
             let _ = writeln!(s, "skeleton: none (no BVH output from this blob)");
         }
+    }
+    if b.tones() == 0 {
+        let _ = writeln!(s, "styles: none (neutral only)");
+    } else {
+        let names: Vec<&str> = b.tone_names().collect();
+        let _ = writeln!(
+            s,
+            "styles: {} tones ({}), mixed with the neutral tables at run time",
+            b.tones(),
+            names.join(", ")
+        );
     }
     s
 }

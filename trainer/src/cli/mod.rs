@@ -15,6 +15,7 @@ macro_rules! outln {
 pub mod args;
 pub mod eval_inference;
 pub mod eval_motion;
+pub mod eval_style;
 pub mod fit;
 pub mod inspect;
 pub mod pack;
@@ -49,6 +50,8 @@ pub enum Command {
     Pack(pack::PackArgs),
     /// Motion quality of the online policy on held-out audio vs random, offline DP, mocap.
     EvalMotion(eval_motion::EvalMotionArgs),
+    /// What each style (tone mix) does to the played motion: hand speed and kinematics.
+    EvalStyle(eval_style::EvalStyleArgs),
     /// Validate a policy blob and summarize it: header, section sizes, dimensions, rig.
     Inspect(inspect::InspectArgs),
 }
@@ -215,6 +218,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::EvalInference(a) => eval_inference::run(&a),
         Command::Pack(a) => pack::run(&a),
         Command::EvalMotion(a) => eval_motion::run(&a),
+        Command::EvalStyle(a) => eval_style::run(&a),
         Command::Inspect(a) => inspect::run(&a),
     }
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::args::{ControlArgs, CorpusArgs, DeviceArgs};
+use super::args::{ControlArgs, CorpusArgs, DeviceArgs, StyleArgs};
 use super::CliError;
 use crate::output::write_atomic;
 use crate::pack::{pack, PackOptions};
@@ -40,6 +40,9 @@ pub struct PackArgs {
     /// How the device runs the policy.
     #[command(flatten)]
     pub device: DeviceArgs,
+    /// Tones mixed at run time.
+    #[command(flatten)]
+    pub styles: StyleArgs,
 }
 
 /// Runs the command.
@@ -47,6 +50,9 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     // No output may be an input (the model, the rig, a library file) or the other output.
     let mut inputs: Vec<std::path::PathBuf> = vec![a.model.clone()];
     inputs.extend(a.rig.clone());
+    let styles = a.styles.options()?;
+    inputs.extend(styles.neutral.iter().cloned());
+    inputs.extend(styles.tones.iter().flat_map(|(_, f)| f.iter().cloned()));
     if let Ok(takes) = crate::corpus::discover(&a.library) {
         inputs.extend(takes.into_iter().flat_map(|t| [t.bvh, t.wav]).flatten());
     }
@@ -69,6 +75,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     a.control.validate()?;
     a.device.validate()?;
     let mut opts = PackOptions {
+        styles,
         control: a.control.params(),
         rig: a.rig.clone(),
         budget_bytes: a.budget_bytes,
@@ -80,7 +87,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
     outln!(
         "wrote {}: {} bytes (front-end {}, inference {}, policy {}, control {}, library {}, \
-         rig {}, skeleton {})",
+         rig {}, skeleton {}, styles {})",
         a.out.display(),
         r.blob_bytes,
         r.section_bytes.front_end,
@@ -89,7 +96,8 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.section_bytes.control,
         r.section_bytes.library,
         r.section_bytes.rig,
-        r.section_bytes.skeleton
+        r.section_bytes.skeleton,
+        r.section_bytes.styles
     )?;
     outln!(
         "library: {} segments, {} exit points, {} frames; rig {} ({} channels)",
@@ -116,6 +124,28 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         100.0 * r.agreement,
         r.regret_decisions
     )?;
+    for t in &r.styles {
+        let f = t.factors;
+        outln!(
+            "tone {}: {} ({} bytes): T x{:.2} D x{:.2} V x{:.2} A x{:.2} C x{:.2} H x{:.2}; \
+             regret {:.4}%, agreement {:.2}%",
+            t.name,
+            if t.segments > 0 {
+                format!("fitted on {} segments", t.segments)
+            } else {
+                "synthetic".into()
+            },
+            t.bytes,
+            f[0],
+            f[1],
+            f[2],
+            f[3],
+            f[4],
+            f[5],
+            100.0 * t.regret,
+            100.0 * t.agreement
+        )?;
+    }
     outln!(
         "time: load {:.2} s, costs {:.2} s, value iteration {:.2} s, pruning {:.2} s, write {:.2} s, total {:.2} s",
         r.timings.load_s,

@@ -12,14 +12,15 @@
 
 use std::time::Instant;
 
-use gesture_runtime::policy::{select, Choice, Penalties, PolicyTables};
+use gesture_runtime::policy::{select_styled, Choice, Penalties, PolicyTables, Style};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::costs::{psi, successor_costs, CostParams, Signatures};
+use super::costs::{psi, psi_of, successor_costs, CostParams, Signatures};
 use super::library::Library;
 use super::mdp::{solve, transition_matrix, Action, MdpParams, Policy};
 use super::prune::{keep_best, pad, prune};
+use super::style::ToneTransform;
 use crate::inference::model::InferenceModel;
 
 /// Settings of the control layer.
@@ -58,8 +59,21 @@ pub struct ControlModel {
     pub pruned: Vec<Vec<usize>>,
     /// Successors kept in the blob per exit (pruned, then truncated to the budget).
     pub kept: Vec<Vec<usize>>,
+    /// The tones' policies (same successor costs, each tone's `psi`).
+    pub tones: Vec<TonePolicy>,
     /// Stage timings.
     pub timings: Timings,
+}
+
+/// One tone's solved control layer.
+#[derive(Clone, Debug)]
+pub struct TonePolicy {
+    /// Its transform.
+    pub transform: ToneTransform,
+    /// `psi^m[c][s]`: the library's segments scored through the transform's inverse.
+    pub psi: Vec<Vec<f64>>,
+    /// The float policy under the tone.
+    pub policy: Policy,
 }
 
 impl ControlModel {
@@ -73,20 +87,52 @@ impl ControlModel {
     }
 }
 
-/// Solves the control layer for `lib` under `model`.
-pub fn build(model: &InferenceModel, lib: &Library, params: &ControlParams) -> ControlModel {
+/// Solves the control layer for `lib` under `model`, and one policy per tone of `tones`
+/// (docs/method.md "Style control"). The successor lists kept are the union of every tone's
+/// non-dominated successors (a successor dominated under every tone is dominated under any
+/// mix of them, since the mixed cost is a convex combination), padded under the neutral policy.
+pub fn build(
+    model: &InferenceModel,
+    lib: &Library,
+    params: &ControlParams,
+    tones: &[ToneTransform],
+) -> ControlModel {
     let t0 = Instant::now();
     let psi = psi(lib, &model.hmm.emit, params.cost.psi_samples);
+    let tone_psi: Vec<Vec<Vec<f64>>> = tones
+        .iter()
+        .map(|t| {
+            let ys: Vec<[f64; 6]> = lib.segments.iter().map(|s| t.invert(&s.y)).collect();
+            psi_of(&ys, &model.hmm.emit, params.cost.psi_samples)
+        })
+        .collect();
     let sig = Signatures::new(lib);
     let succ = successor_costs(lib, &sig, &params.cost);
     let t1 = Instant::now();
     let p = transition_matrix(&model.crf.trans, model.states());
-    let policy = solve(lib, &psi, succ, &p, &params.mdp);
+    let policy = solve(lib, &psi, succ.clone(), &p, &params.mdp);
+    let tones: Vec<TonePolicy> = tones
+        .iter()
+        .zip(tone_psi)
+        .map(|(t, psi)| TonePolicy {
+            transform: t.clone(),
+            policy: solve(lib, &psi, succ.clone(), &p, &params.mdp),
+            psi,
+        })
+        .collect();
     let t2 = Instant::now();
     let min = params
         .min_successors
         .unwrap_or(super::prune::MIN_SUCCESSORS);
-    let pruned = pad(&policy, &prune(&policy), &model.state_prior, min);
+    let mut front = prune(&policy);
+    for t in &tones {
+        for (all, more) in front.iter_mut().zip(prune(&t.policy)) {
+            all.extend(more);
+            all.sort_unstable();
+            all.dedup();
+        }
+    }
+    let pruned = pad(&policy, &front, &model.state_prior, min);
     let kept = match params.max_successors {
         Some(k) => keep_best(&policy, &pruned, &model.state_prior, k),
         None => pruned.clone(),
@@ -97,6 +143,7 @@ pub fn build(model: &InferenceModel, lib: &Library, params: &ControlParams) -> C
         policy,
         pruned,
         kept,
+        tones,
         timings: Timings {
             costs: (t1 - t0).as_secs_f64(),
             value_iteration: (t2 - t1).as_secs_f64(),
@@ -117,15 +164,18 @@ pub struct RegretReport {
 }
 
 /// Simulates `decisions` decisions (seeded) and measures regret; see the module docs.
+/// `policy` is the float unpruned policy to compare with (the neutral one, or a tone's), and
+/// `style` the weights the packed tables `q` are read with (one-hot on that tone).
 pub fn regret(
     lib: &Library,
-    cm: &ControlModel,
+    policy: &Policy,
     q: &impl PolicyTables,
+    style: &Style,
     model: &InferenceModel,
     decisions: usize,
     seed: u64,
 ) -> RegretReport {
-    let s = cm.policy.states;
+    let s = policy.states;
     let p = transition_matrix(&model.crf.trans, s);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let sample = |row: &[f64], rng: &mut ChaCha8Rng| {
@@ -161,14 +211,14 @@ pub fn regret(
             belief = nb.iter().map(|v| v / z).collect();
         }
         let bf: Vec<f32> = belief.iter().map(|&v| v as f32).collect();
-        let dq = select(q, e, &bf, &Penalties::NONE);
+        let dq = select_styled(q, e, &bf, &Penalties::NONE, style);
         let chosen = match dq.choice {
             Choice::Continue => Action::Continue,
             Choice::Enter(c) => Action::Enter(c),
         };
-        let best = cm.policy.decide(e, &belief, 0..lib.segments.len());
-        let cb = cm.policy.cost(e, best, &belief);
-        let cc = cm.policy.cost(e, chosen, &belief);
+        let best = policy.decide(e, &belief, 0..lib.segments.len());
+        let cb = policy.cost(e, best, &belief);
+        let cc = policy.cost(e, chosen, &belief);
         same += (best == chosen) as usize;
         excess += (cc - cb).max(0.0);
         best_total += cb.abs();

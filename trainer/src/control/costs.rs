@@ -57,6 +57,13 @@ impl Default for CostParams {
 
 /// `psi[a][i]` for every segment and state.
 pub fn psi(lib: &Library, states: &[Gaussian], samples: usize) -> Vec<Vec<f64>> {
+    let ys: Vec<[f64; 6]> = lib.segments.iter().map(|s| s.y).collect();
+    psi_of(&ys, states, samples)
+}
+
+/// `psi[a][i]` for segments whose kinematic vectors are `ys` (a tone scores the library's
+/// segments through its transform, see `super::style`).
+pub fn psi_of(ys: &[[f64; 6]], states: &[Gaussian], samples: usize) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5053_4931);
     let z: Vec<[f64; 6]> = (0..samples)
         .map(|_| std::array::from_fn(|_| StandardNormal.sample(&mut rng)))
@@ -80,14 +87,13 @@ pub fn psi(lib: &Library, states: &[Gaussian], samples: usize) -> Vec<Vec<f64>> 
                 .collect()
         })
         .collect();
-    lib.segments
-        .par_iter()
-        .map(|s| {
+    ys.par_iter()
+        .map(|sy| {
             draws
                 .iter()
                 .map(|d| {
                     d.iter()
-                        .map(|y| (0..6).map(|k| (y[k] - s.y[k]).powi(2)).sum::<f64>().sqrt())
+                        .map(|y| (0..6).map(|k| (y[k] - sy[k]).powi(2)).sum::<f64>().sqrt())
                         .sum::<f64>()
                         / d.len().max(1) as f64
                 })

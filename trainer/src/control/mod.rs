@@ -8,7 +8,8 @@
 //! - [`prune`]: dropping successors that are never optimal, and budget truncation;
 //! - [`dp`]: the offline dynamic-programming reference;
 //! - [`build`]: model + library to a solved, pruned policy and its regret.
-//! - [`schedule`]: what random selection and the offline DP reference play, frame by frame.
+//! - [`schedule`]: what random selection and the offline DP reference play, frame by frame;
+//! - [`style`]: tone transforms of the kinematic parameters (per-tone value tables).
 
 // Index loops mirror the recursion's subscripts and are kept on purpose.
 #![allow(clippy::needless_range_loop)]
@@ -20,6 +21,7 @@ pub mod library;
 pub mod mdp;
 pub mod prune;
 pub mod schedule;
+pub mod style;
 
 pub use library::{ExitPoint, LibSegment, Library};
 pub use mdp::{Action, MdpParams, Policy};

@@ -5,8 +5,10 @@
 //!   smoothness, beats, hand speeds), from poses on the library's skeleton.
 //! - [`motion`]: motion quality of the online controller on held-out audio against its
 //!   ablations, random selection, the offline DP reference and the motion capture.
+//! - [`style`]: what each style (tone mix) does to the played motion;
 //! - [`table`]: the printed table of those figures.
 
 pub mod metrics;
 pub mod motion;
+pub mod style;
 pub mod table;

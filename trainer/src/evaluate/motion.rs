@@ -133,7 +133,7 @@ pub struct Playback {
 
 /// One online decision: exit, choice, and the belief it was made with.
 #[derive(Clone, Debug)]
-struct Made {
+pub(crate) struct Made {
     exit: usize,
     choice: Choice,
     belief: Vec<f64>,
@@ -142,7 +142,7 @@ struct Made {
 /// Runs the blob's device loop on `samples` (starting at segment 0), after `setup` on its
 /// controller; returns the first `frames` ticks (the last one repeated if the audio ends
 /// earlier) and the decisions.
-fn play_online(
+pub(crate) fn play_online(
     blob: &Blob<'_>,
     samples: &[i16],
     frames: usize,
@@ -230,7 +230,7 @@ fn trace_of(
 }
 
 /// The audio's samples (files in order, the span applied) at the model's rate.
-fn load_audio(model: &InferenceModel, e: &MotionEval) -> Result<Vec<i16>, EvalError> {
+pub(crate) fn load_audio(model: &InferenceModel, e: &MotionEval) -> Result<Vec<i16>, EvalError> {
     let rate = model.sample_rate_hz as f64;
     let mut all = Vec::new();
     for path in &e.audio {

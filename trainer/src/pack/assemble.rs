@@ -5,7 +5,7 @@
 
 use gesture_runtime::blob::encode::{
     encode, EncodeError, JointSpec, OwnedInference, OwnedLibrary, OwnedPolicy, OwnedRig,
-    OwnedSkeleton, PolicyInput, SegmentSpec,
+    OwnedSkeleton, OwnedStyles, PolicyInput, SegmentSpec,
 };
 use gesture_runtime::blob::{ControlSection, FrontEndSection, Payload, EULER_ORDERS};
 use gesture_runtime::prosody::ProsodyConfig;
@@ -171,8 +171,38 @@ pub fn policy_section(
     })
 }
 
-/// The blob's bytes for `parts` and `policy`.
-pub fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, EncodeError> {
+/// The `styles` section of a solved control layer with tones (`None` without tones).
+pub fn styles_section(cm: &ControlModel) -> Result<Option<OwnedStyles>, EncodeError> {
+    if cm.tones.is_empty() {
+        return Ok(None);
+    }
+    let s = cm.policy.states;
+    let names: Vec<&str> = cm.tones.iter().map(|t| t.transform.name.as_str()).collect();
+    let u: Vec<Vec<f64>> = cm
+        .tones
+        .iter()
+        .map(|t| t.policy.u.iter().flatten().copied().collect())
+        .collect();
+    let u_cont: Vec<Vec<f64>> = cm
+        .tones
+        .iter()
+        .map(|t| {
+            t.policy
+                .u_cont
+                .iter()
+                .flat_map(|o| o.clone().unwrap_or_else(|| vec![0.0; s]))
+                .collect()
+        })
+        .collect();
+    OwnedStyles::new(&names, &u, &u_cont).map(Some)
+}
+
+/// The blob's bytes for `parts`, `policy` and `styles`.
+pub fn encode_with(
+    parts: &Parts,
+    policy: &OwnedPolicy,
+    styles: Option<&OwnedStyles>,
+) -> Result<Vec<u8>, EncodeError> {
     encode(&Payload {
         front_end: parts.front_end,
         inference: parts.inference.section(),
@@ -181,7 +211,7 @@ pub fn encode_with(parts: &Parts, policy: &OwnedPolicy) -> Result<Vec<u8>, Encod
         library: parts.library.section(),
         rig: parts.rig.section(),
         skeleton: parts.skeleton.as_ref().map(OwnedSkeleton::section),
-        styles: None,
+        styles: styles.map(OwnedStyles::section),
     })
 }
 

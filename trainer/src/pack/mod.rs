@@ -18,6 +18,12 @@
 //! channel drives. A library that mixes skeletons is refused with the first difference; pack
 //! each skeleton family into its own blob. `no_skeleton` leaves the section out (the device
 //! never reads it; it costs a few KiB for a 75-joint body).
+//!
+//! **Tones** ([`StyleOptions`], docs/method.md "Style control"): with neutral motion and motion
+//! per tone (any BVH, any skeleton: the transform is relative), each tone's transform is
+//! fitted ([`crate::control::style`]), the library's segments are scored through it, one value
+//! function is solved per tone, and the blob gets a `styles` section with their tables; the
+//! successor lists are shared. `energy` adds the two synthetic tones of the energy knob.
 
 pub mod assemble;
 pub mod plant;
@@ -28,19 +34,20 @@ use std::time::Instant;
 use gesture_runtime::blob::encode::EncodeError;
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::DecisionTiming;
-use gesture_runtime::policy::Variety;
+use gesture_runtime::policy::{Style, Variety};
 use serde::Serialize;
 
 use crate::control::build::{build, fit_budget, regret, ControlModel, ControlParams};
 use crate::control::library::LibraryError;
+use crate::control::style::{ToneError, ToneTransform, ENERGY_TONES};
 use crate::control::Library;
 use crate::corpus::discover;
 use crate::inference::model::{InferenceModel, ModelError};
 use crate::motion::fk::Target;
-use crate::motion::{EffectorSpec, Motion, SegmentParams, Skeleton};
+use crate::motion::{analyze, read_bvh, EffectorSpec, Motion, SegmentParams, Skeleton};
 use crate::output::{write_atomic, OutputError};
 use crate::rig::{Rig, RigError};
-use assemble::{encode_with, parts, policy_section};
+use assemble::{encode_with, parts, policy_section, styles_section};
 
 /// Variety costs a blob gets by default (see `gesture_runtime::policy`): chosen with
 /// `gesture-train eval-motion` on held-out spans of the ZeroEGGS takes (README, "Motion
@@ -76,6 +83,19 @@ pub struct PackOptions {
     pub effectors: EffectorSpec,
     /// Leave out the host-side skeleton section.
     pub no_skeleton: bool,
+    /// Tones (none by default).
+    pub styles: StyleOptions,
+}
+
+/// Tones to pack (see the module docs).
+#[derive(Clone, Debug, Default)]
+pub struct StyleOptions {
+    /// BVH files of neutral motion (needed with `tones`).
+    pub neutral: Vec<PathBuf>,
+    /// Per tone: its name and the BVH files that show it.
+    pub tones: Vec<(String, Vec<PathBuf>)>,
+    /// Add the energy knob's tones (`energetic`, `calm`) with this factor (> 1).
+    pub energy: Option<f64>,
 }
 
 impl Default for PackOptions {
@@ -90,6 +110,7 @@ impl Default for PackOptions {
             plant_feet: true,
             effectors: EffectorSpec::default(),
             no_skeleton: false,
+            styles: StyleOptions::default(),
         }
     }
 }
@@ -113,6 +134,27 @@ pub struct SectionBytes {
     pub rig: usize,
     /// Host-side skeleton (1 byte when left out).
     pub skeleton: usize,
+    /// Tones' value tables (1 byte without tones).
+    pub styles: usize,
+}
+
+/// One tone of the pack report.
+#[derive(Clone, Debug, Serialize)]
+pub struct ToneReport {
+    /// Its name.
+    pub name: String,
+    /// Motion segments its transform was fitted on (0: synthetic).
+    pub segments: usize,
+    /// Mean factor of T, D, V, A, C, H under the tone against neutral (`exp` of the shift of
+    /// the log parameters).
+    pub factors: [f64; 6],
+    /// Regret of the packed tables read with this tone's weight at 1, against its float
+    /// unpruned policy.
+    pub regret: f64,
+    /// Agreement of those decisions with its float unpruned policy.
+    pub agreement: f64,
+    /// Bytes its tables add to the blob.
+    pub bytes: usize,
 }
 
 /// Stage timings (s).
@@ -159,6 +201,8 @@ pub struct PackReport {
     pub regret: f64,
     /// Fraction of simulated decisions equal to the float unpruned policy's.
     pub agreement: f64,
+    /// The tones, in the blob's order.
+    pub styles: Vec<ToneReport>,
     /// Decisions simulated for the regret.
     pub regret_decisions: usize,
     /// Rig name.
@@ -218,6 +262,12 @@ pub enum PackError {
     /// The model's front-end settings are not ones this runtime accepts.
     #[error("{0}")]
     FrontEnd(String),
+    /// A tone's motion or options.
+    #[error("{0}")]
+    Style(String),
+    /// A tone's transform could not be fitted.
+    #[error(transparent)]
+    Tone(#[from] ToneError),
     /// The writer refused the content (a packer bug or a dimension beyond the format).
     #[error(transparent)]
     Encode(#[from] EncodeError),
@@ -298,16 +348,19 @@ pub fn pack_model(
         None
     };
     let (parts, frames) = parts(model, &lib, &rig, opts)?;
+    progress.set_message("pack: fitting the tones");
+    let tones = tone_transforms(model, &opts.styles, &opts.effectors)?;
     let load_s = start.elapsed().as_secs_f64();
 
     progress.set_message("pack: value iteration and pruning");
-    let mut cm = build(model, &lib, &opts.control);
+    let mut cm = build(model, &lib, &opts.control, &tones);
     let t_prune = Instant::now();
     let mut k = None;
     if let Some(budget) = opts.budget_bytes {
+        let styles = styles_section(&cm)?;
         let size = |c: &ControlModel| {
             policy_section(model, &lib, c)
-                .and_then(|p| encode_with(&parts, &p))
+                .and_then(|p| encode_with(&parts, &p, styles.as_ref()))
                 .map_or(usize::MAX, |b| b.len())
         };
         k = fit_budget(model, &mut cm, budget, &size);
@@ -324,7 +377,8 @@ pub fn pack_model(
     let pruning_extra = t_prune.elapsed().as_secs_f64();
     let t_write = Instant::now();
     let policy = policy_section(model, &lib, &cm)?;
-    let bytes = encode_with(&parts, &policy)?;
+    let styles = styles_section(&cm)?;
+    let bytes = encode_with(&parts, &policy, styles.as_ref())?;
     // The writer checked the bytes; what is measured below is what the device reads.
     let blob = Blob::parse(&bytes).map_err(EncodeError::Invalid)?;
     let sizes = blob.section_sizes();
@@ -332,7 +386,35 @@ pub fn pack_model(
     let t_regret = Instant::now();
     progress.set_message("pack: regret of the packed tables");
     let decisions = 20_000;
-    let r = regret(&lib, &cm, &blob, model, decisions, 7);
+    let r = regret(
+        &lib,
+        &cm.policy,
+        &blob,
+        &Style::NEUTRAL,
+        model,
+        decisions,
+        7,
+    );
+    let tone_reports = cm
+        .tones
+        .iter()
+        .enumerate()
+        .map(|(m, t)| {
+            let mut w = vec![0.0f32; cm.tones.len()];
+            w[m] = 1.0;
+            let style = Style::new(&w).map_err(|e| PackError::Style(e.to_string()))?;
+            let r = regret(&lib, &t.policy, &blob, &style, model, decisions, 7);
+            Ok(ToneReport {
+                name: t.transform.name.clone(),
+                segments: t.transform.segments,
+                factors: t.transform.factors(&model.normalization),
+                regret: r.regret,
+                agreement: r.agreement,
+                // Two i16 per segment and exit point per state.
+                bytes: 2 * model.states() * (lib.segments.len() + lib.exits.len()),
+            })
+        })
+        .collect::<Result<Vec<_>, PackError>>()?;
     let regret_s = t_regret.elapsed().as_secs_f64();
     progress.finish_and_clear();
     let report = PackReport {
@@ -346,6 +428,7 @@ pub fn pack_model(
             library: sizes.library,
             rig: sizes.rig,
             skeleton: sizes.skeleton,
+            styles: sizes.styles,
         },
         segments: lib.segments.len(),
         exit_points: lib.exits.len(),
@@ -356,6 +439,7 @@ pub fn pack_model(
         successors_per_exit: k,
         regret: r.regret,
         agreement: r.agreement,
+        styles: tone_reports,
         regret_decisions: decisions,
         rig: rig.name.clone(),
         channels: rig.channels.len(),
@@ -386,6 +470,67 @@ pub fn pack_model(
         library: lib,
         control: cm,
     })
+}
+
+/// Normalized kinematic vectors of every segment of the BVH files `files`.
+fn segment_vectors(
+    model: &InferenceModel,
+    files: &[PathBuf],
+    effectors: &EffectorSpec,
+) -> Result<Vec<[f64; 6]>, PackError> {
+    let mut ys = Vec::new();
+    for f in files {
+        let motion = read_bvh(f).map_err(LibraryError::from)?;
+        let analysis = analyze(&motion, effectors, &SegmentParams::default())
+            .map_err(|e| LibraryError::Analysis(format!("{}: {e}", f.display())))?;
+        ys.extend(analysis.y_raw.iter().map(|y| model.normalization.apply(y)));
+    }
+    Ok(ys)
+}
+
+/// The tones' transforms: fitted from motion, then the energy knob's (see [`StyleOptions`]).
+pub fn tone_transforms(
+    model: &InferenceModel,
+    st: &StyleOptions,
+    effectors: &EffectorSpec,
+) -> Result<Vec<ToneTransform>, PackError> {
+    let mut out = Vec::new();
+    if !st.tones.is_empty() {
+        if st.neutral.is_empty() {
+            return Err(PackError::Style(
+                "--style needs neutral motion to compare with: give --style-neutral FILES".into(),
+            ));
+        }
+        let neutral = segment_vectors(model, &st.neutral, effectors)?;
+        for (name, files) in &st.tones {
+            let ys = segment_vectors(model, files, effectors)?;
+            out.push(ToneTransform::fit(name, &neutral, &ys)?);
+        }
+    }
+    if let Some(f) = st.energy {
+        if !(f.is_finite() && f > 1.0) {
+            return Err(PackError::Style(format!(
+                "--energy {f}: the factor must be a number above 1 (e.g. 1.5)"
+            )));
+        }
+        if let Some(n) = ENERGY_TONES
+            .iter()
+            .find(|n| st.tones.iter().any(|(t, _)| t == *n))
+        {
+            return Err(PackError::Style(format!(
+                "--style {n}: the name is taken by the --energy knob's tones"
+            )));
+        }
+        out.extend(ToneTransform::energy(f, &model.normalization));
+    }
+    if out.len() > gesture_runtime::policy::MAX_TONES {
+        return Err(PackError::Style(format!(
+            "{} tones, a blob holds at most {} (the energy knob counts two)",
+            out.len(),
+            gesture_runtime::policy::MAX_TONES
+        )));
+    }
+    Ok(out)
 }
 
 /// Holds the lower body of the library's takes (see [`plant`]); `None` without feet.
