@@ -31,8 +31,8 @@
 //! tables per tone (`U^m`, `U_cont^m`, solved by the trainer with each tone's transform of the
 //! kinematic parameters) beside the neutral ones. A [`Style`] holds the user's weights `d`;
 //! the selector uses `U = d_0 U + sum_m d_m U^m` (and likewise `U_cont`), `d_0 = 1 - sum d_m`
-//! the neutral weight, computed per candidate from the stored tables, so no mixed copy is kept
-//! in RAM. The neutral style reads the neutral tables alone, exactly as a blob without tones.
+//! the neutral weight, computed per candidate as `d_0 (b . U) + sum_m d_m (b . U^m)` from the
+//! stored tables, so no mixed copy is kept in RAM. The neutral style reads the neutral tables alone, exactly as a blob without tones.
 //!
 //! The tables come from a validated blob through [`PolicyTables`]; every index the selector
 //! uses was range-checked at load, so nothing here can panic.
@@ -62,6 +62,40 @@ pub trait PolicyTables {
     fn successor_count(&self, e: usize) -> usize;
     /// The `k`-th successor of exit `e`: `(segment, S(e, segment))`.
     fn successor(&self, e: usize, k: usize) -> (usize, f32);
+    /// `b . U(c)` over the states (`b` has `states()` entries). The default sums
+    /// `b[s] * u(c, s)` in state order; an implementation may read the row at once but must
+    /// give the same number.
+    fn u_dot(&self, c: usize, b: &[f32]) -> f32 {
+        let mut acc = 0.0f32;
+        for (s, &bs) in b.iter().enumerate().take(self.states()) {
+            acc += bs * self.u(c, s);
+        }
+        acc
+    }
+    /// `b . U_cont(e)`, like [`u_dot`](Self::u_dot).
+    fn u_cont_dot(&self, e: usize, b: &[f32]) -> f32 {
+        let mut acc = 0.0f32;
+        for (s, &bs) in b.iter().enumerate().take(self.states()) {
+            acc += bs * self.u_cont(e, s);
+        }
+        acc
+    }
+    /// `b . U^m(c)`, like [`u_dot`](Self::u_dot).
+    fn tone_u_dot(&self, m: usize, c: usize, b: &[f32]) -> f32 {
+        let mut acc = 0.0f32;
+        for (s, &bs) in b.iter().enumerate().take(self.states()) {
+            acc += bs * self.tone_u(m, c, s);
+        }
+        acc
+    }
+    /// `b . U_cont^m(e)`, like [`u_dot`](Self::u_dot).
+    fn tone_u_cont_dot(&self, m: usize, e: usize, b: &[f32]) -> f32 {
+        let mut acc = 0.0f32;
+        for (s, &bs) in b.iter().enumerate().take(self.states()) {
+            acc += bs * self.tone_u_cont(m, e, s);
+        }
+        acc
+    }
     /// Tones with tables of their own (0: the neutral tables only).
     fn tones(&self) -> usize {
         0
@@ -194,39 +228,41 @@ impl Style {
         self.tones == 0
     }
 
-    /// `U(c, s)` mixed with these weights; exactly `t.u(c, s)` when neutral.
+    /// `b . U(c)` with the tables mixed by these weights: `d_0 (b . U(c)) + sum_m d_m (b .
+    /// U^m(c))`, exactly `t.u_dot(c, b)` when neutral. Each table is read once per candidate
+    /// (a row of S values), so a mix of M tones costs M + 1 dot products.
     #[inline]
-    fn u<T: PolicyTables + ?Sized>(&self, t: &T, c: usize, s: usize) -> f32 {
+    fn u_dot<T: PolicyTables + ?Sized>(&self, t: &T, c: usize, b: &[f32]) -> f32 {
         if self.is_neutral() {
-            return t.u(c, s);
+            return t.u_dot(c, b);
         }
         let mut v = if self.neutral > 0.0 {
-            self.neutral * t.u(c, s)
+            self.neutral * t.u_dot(c, b)
         } else {
             0.0
         };
         for (m, &w) in self.weights().iter().enumerate().take(t.tones()) {
             if w > 0.0 {
-                v += w * t.tone_u(m, c, s);
+                v += w * t.tone_u_dot(m, c, b);
             }
         }
         v
     }
 
-    /// `U_cont(e, s)` mixed with these weights; exactly `t.u_cont(e, s)` when neutral.
+    /// `b . U_cont(e)` mixed like [`u_dot`](Self::u_dot).
     #[inline]
-    fn u_cont<T: PolicyTables + ?Sized>(&self, t: &T, e: usize, s: usize) -> f32 {
+    fn u_cont_dot<T: PolicyTables + ?Sized>(&self, t: &T, e: usize, b: &[f32]) -> f32 {
         if self.is_neutral() {
-            return t.u_cont(e, s);
+            return t.u_cont_dot(e, b);
         }
         let mut v = if self.neutral > 0.0 {
-            self.neutral * t.u_cont(e, s)
+            self.neutral * t.u_cont_dot(e, b)
         } else {
             0.0
         };
         for (m, &w) in self.weights().iter().enumerate().take(t.tones()) {
             if w > 0.0 {
-                v += w * t.tone_u_cont(m, e, s);
+                v += w * t.tone_u_cont_dot(m, e, b);
             }
         }
         v
@@ -383,14 +419,6 @@ impl Penalties {
     }
 }
 
-fn dot<T: PolicyTables + ?Sized>(t: &T, b: &[f32], f: impl Fn(&T, usize) -> f32) -> f32 {
-    let mut acc = 0.0f32;
-    for (s, &bs) in b.iter().enumerate().take(t.states()) {
-        acc += bs * f(t, s);
-    }
-    acc
-}
-
 /// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries), each
 /// candidate segment `c` charged `penalty.of(c)` on top and continuing charged the usage of
 /// the exit's segment, `penalty.usage_of(..)`. At an end exit with no successor (a
@@ -421,12 +449,12 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
         candidates: 0,
     };
     if !t.exit_is_end(e) {
-        best.cost = dot(t, b, |t, s| style.u_cont(t, e, s)) + penalty.usage_of(t.exit_segment(e));
+        best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(t.exit_segment(e));
         best.candidates = 1;
     }
     for k in 0..t.successor_count(e) {
         let (c, sc) = t.successor(e, k);
-        let v = sc + dot(t, b, |t, s| style.u(t, c, s)) + penalty.of(c);
+        let v = sc + style.u_dot(t, c, b) + penalty.of(c);
         best.candidates += 1;
         if v < best.cost {
             best.cost = v;

@@ -171,3 +171,33 @@ fn the_controller_takes_a_style_for_its_tables_only() {
     assert!(c.set_style(&[1.0]).is_err());
     assert!(c.set_style(&[]).is_ok());
 }
+
+/// The blob reads a row of a value table at once; the number is bit for bit the per-state sum
+/// (so the selector's costs did not change with it).
+#[test]
+fn row_dot_products_equal_the_per_state_sums() {
+    let bytes = styled_bytes();
+    let blob = Blob::parse(&bytes).unwrap();
+    let b = [0.3f32, 0.7];
+    let sum =
+        |f: &dyn Fn(usize) -> f32| b.iter().enumerate().fold(0.0f32, |a, (s, &w)| a + w * f(s));
+    for c in 0..2 {
+        assert_eq!(blob.u_dot(c, &b), sum(&|s| blob.u(c, s)));
+        for m in 0..2 {
+            assert_eq!(blob.tone_u_dot(m, c, &b), sum(&|s| blob.tone_u(m, c, s)));
+        }
+    }
+    for e in 0..3 {
+        assert_eq!(blob.u_cont_dot(e, &b), sum(&|s| blob.u_cont(e, s)));
+        for m in 0..2 {
+            assert_eq!(
+                blob.tone_u_cont_dot(m, e, &b),
+                sum(&|s| blob.tone_u_cont(m, e, s))
+            );
+        }
+    }
+    // Out of range reads 0; a longer belief is cut to the states.
+    assert_eq!(blob.u_dot(2, &b), 0.0);
+    assert_eq!(blob.tone_u_dot(2, 0, &b), 0.0);
+    assert_eq!(blob.u_dot(1, &[0.3, 0.7, 5.0]), blob.u_dot(1, &b));
+}

@@ -37,6 +37,18 @@ impl PolicyTables for Blob<'_> {
     fn successor(&self, e: usize, k: usize) -> (usize, f32) {
         Blob::successor(self, e, k).map_or((0, f32::INFINITY), |s| (s.segment as usize, s.cost))
     }
+    fn u_dot(&self, c: usize, b: &[f32]) -> f32 {
+        Blob::u_dot(self, c, b)
+    }
+    fn u_cont_dot(&self, e: usize, b: &[f32]) -> f32 {
+        Blob::u_cont_dot(self, e, b)
+    }
+    fn tone_u_dot(&self, m: usize, c: usize, b: &[f32]) -> f32 {
+        Blob::tone_u_dot(self, m, c, b)
+    }
+    fn tone_u_cont_dot(&self, m: usize, e: usize, b: &[f32]) -> f32 {
+        Blob::tone_u_cont_dot(self, m, e, b)
+    }
     fn tones(&self) -> usize {
         Blob::tones(self)
     }

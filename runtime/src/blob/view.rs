@@ -270,6 +270,27 @@ impl<'a> Blob<'a> {
         self.u_cont.get(exit * self.states() + state)
     }
 
+    /// `b . U(segment)` over the first `states()` entries of `b`, read as one row (the same
+    /// number as summing `b[s] * u(segment, s)` in order); 0 out of range.
+    #[inline]
+    pub fn u_dot(&self, segment: usize, b: &[f32]) -> f32 {
+        let s = self.states();
+        if segment >= self.segments() {
+            return 0.0;
+        }
+        self.u.dot(segment * s, &b[..b.len().min(s)])
+    }
+
+    /// `b . U_cont(exit)`, like [`u_dot`](Self::u_dot).
+    #[inline]
+    pub fn u_cont_dot(&self, exit: usize, b: &[f32]) -> f32 {
+        let s = self.states();
+        if exit >= self.exit_points() {
+            return 0.0;
+        }
+        self.u_cont.dot(exit * s, &b[..b.len().min(s)])
+    }
+
     /// Exit point `e`.
     pub fn exit(&self, e: usize) -> Option<ExitPoint> {
         let r = record::<EXIT_RECORD_BYTES>(self.payload.policy.exits, e)?;
@@ -549,6 +570,28 @@ impl<'a> Blob<'a> {
         // Bounded by the capacities, so the index arithmetic cannot overflow.
         self.tone_u
             .get((tone * self.segments() + segment) * self.states() + state)
+    }
+
+    /// `b . U^m(segment)` of tone `tone`, like [`u_dot`](Self::u_dot).
+    #[inline]
+    pub fn tone_u_dot(&self, tone: usize, segment: usize, b: &[f32]) -> f32 {
+        let s = self.states();
+        if tone >= self.tones() || segment >= self.segments() {
+            return 0.0;
+        }
+        self.tone_u
+            .dot((tone * self.segments() + segment) * s, &b[..b.len().min(s)])
+    }
+
+    /// `b . U_cont^m(exit)` of tone `tone`, like [`u_dot`](Self::u_dot).
+    #[inline]
+    pub fn tone_u_cont_dot(&self, tone: usize, exit: usize, b: &[f32]) -> f32 {
+        let s = self.states();
+        if tone >= self.tones() || exit >= self.exit_points() {
+            return 0.0;
+        }
+        self.tone_u_cont
+            .dot((tone * self.exit_points() + exit) * s, &b[..b.len().min(s)])
     }
 
     /// U_cont^m(exit, state) of tone `tone` (0 out of range).

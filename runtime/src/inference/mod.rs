@@ -120,6 +120,29 @@ impl<'a> I16Table<'a> {
         self.bytes.is_empty()
     }
 
+    /// `sum_k w[k] * value(start + k)` over `w` (in order, each value `i16 as f32 * scale` as
+    /// [`get`](Self::get) gives it, so the result is bit for bit that of the same loop over
+    /// `get`); values past the end count 0.
+    #[inline]
+    pub fn dot(&self, start: usize, w: &[f32]) -> f32 {
+        let lo = start.saturating_mul(2);
+        let hi = lo.saturating_add(w.len().saturating_mul(2));
+        let mut acc = 0.0f32;
+        match self.bytes.get(lo..hi) {
+            Some(row) => {
+                for (b, &wk) in row.chunks_exact(2).zip(w) {
+                    acc += wk * (i16::from_le_bytes([b[0], b[1]]) as f32 * self.scale);
+                }
+            }
+            None => {
+                for (k, &wk) in w.iter().enumerate() {
+                    acc += wk * self.get(start.saturating_add(k));
+                }
+            }
+        }
+        acc
+    }
+
     /// Value `i` (0 past the end; validated tables are never indexed past the end).
     #[inline]
     pub fn get(&self, i: usize) -> f32 {
