@@ -21,15 +21,35 @@ fn golden() -> Vec<u8> {
         .collect()
 }
 
+/// The golden blob with two tones.
+fn styled() -> Vec<u8> {
+    let mut t = common::Tiny::new();
+    t.styles = Some(common::TinyStyles::two(4, 6));
+    t.encode()
+}
+
 /// Drives the controller of `bytes` (if they parse) with `samples` in `chunk`-sized pieces;
 /// every pose must be finite and within the limits.
 fn drive(bytes: &[u8], samples: &[i16], chunk: usize) -> Result<usize, TestCaseError> {
+    drive_styled(bytes, samples, chunk, &[])
+}
+
+/// [`drive`] with the style `weights` set first (refused weights keep the neutral style).
+fn drive_styled(
+    bytes: &[u8],
+    samples: &[i16],
+    chunk: usize,
+    weights: &[f32],
+) -> Result<usize, TestCaseError> {
     let Ok(blob) = Blob::parse(bytes) else {
         return Ok(0);
     };
     let Ok(mut ctl) = BlobController::from_blob(&blob) else {
         return Ok(0);
     };
+    if ctl.set_style(weights).is_err() {
+        prop_assert!(ctl.style().is_neutral());
+    }
     let mut poses = 0;
     let mut bad = None;
     for c in samples.chunks(chunk.max(1)) {
@@ -79,6 +99,24 @@ proptest! {
             b[12..16].copy_from_slice(&crc.to_le_bytes());
         }
         drive(&b, &samples, 160)?;
+    }
+
+    #[test]
+    fn arbitrary_styles_and_mutated_styled_blobs_never_misbehave(
+        weights in proptest::collection::vec(any::<f32>(), 0..4),
+        edits in proptest::collection::vec((any::<usize>(), any::<u8>()), 0..4),
+        samples in proptest::collection::vec(any::<i16>(), 0..6000),
+    ) {
+        let mut b = styled();
+        let n = b.len();
+        for (at, v) in edits {
+            // The styles section sits at the end: edit there.
+            let i = n - 1 - at % 40;
+            b[i] = v;
+        }
+        let crc = gesture_runtime::blob::crc32(&b[16..]);
+        b[12..16].copy_from_slice(&crc.to_le_bytes());
+        drive_styled(&b, &samples, 160, &weights)?;
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! Arbitrary bytes as a blob: parse, and when it is valid, build the controller and feed it
-//! samples made of the same bytes. Never a panic; every pose finite and within the rig's limits.
+//! samples made of the same bytes, under a style made of them too. Never a panic; every pose
+//! finite and within the rig's limits.
 #![no_main]
 
 use gesture_runtime::blob::Blob;
@@ -14,6 +15,14 @@ fuzz_target!(|data: &[u8]| {
     let Ok(mut ctl) = BlobController::from_blob(&blob) else {
         return;
     };
+    // A style from the bytes (any weights, some refused): the mixed tables drive the choice.
+    let weights: Vec<f32> = data
+        .iter()
+        .rev()
+        .take(blob.tones())
+        .map(|&b| f32::from(b) / 64.0 - 0.5)
+        .collect();
+    let _ = ctl.set_style(&weights);
     let samples: Vec<i16> = data
         .chunks(2)
         .cycle()

@@ -24,6 +24,14 @@ fuzz_target!(|data: &[u8]| {
     let Ok(mut ctl) = BlobController::from_blob(&blob) else {
         return;
     };
+    // A style from the bytes (any weights, some refused): the mixed tables drive the choice.
+    let weights: Vec<f32> = data
+        .iter()
+        .rev()
+        .take(blob.tones())
+        .map(|&b| f32::from(b) / 64.0 - 0.5)
+        .collect();
+    let _ = ctl.set_style(&weights);
     let samples: Vec<i16> = (0..8000)
         .map(|i| ((i * 7919) % 65536) as u16 as i16)
         .collect();
