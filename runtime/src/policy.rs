@@ -176,7 +176,7 @@ impl Style {
                 tones: MAX_TONES as u32,
             });
         }
-        let mut sum = 0.0f32;
+        let mut max = 0.0f32;
         for (m, &w) in weights.iter().enumerate() {
             if !w.is_finite() {
                 return Err(StyleError::NotFinite { tone: m as u32 });
@@ -184,31 +184,27 @@ impl Style {
             if w < 0.0 {
                 return Err(StyleError::Negative { tone: m as u32 });
             }
-            sum += w;
+            max = max.max(w);
         }
+        if max == 0.0 {
+            return Ok(Self::NEUTRAL);
+        }
+        // Relative to the largest weight the sum is 1..=8, so it cannot overflow.
         let mut st = Self::NEUTRAL;
-        if !sum.is_finite() {
-            // Finite weights whose sum overflows: scale first.
-            let max = weights.iter().fold(0.0f32, |a, &b| a.max(b));
-            let mut s2 = 0.0f32;
-            for (t, &w) in st.tone.iter_mut().zip(weights) {
-                *t = w / max;
-                s2 += *t;
-            }
-            st.tone.iter_mut().for_each(|t| *t /= s2);
-            st.neutral = 0.0;
-        } else if sum > 1.0 {
-            for (t, &w) in st.tone.iter_mut().zip(weights) {
-                *t = w / sum;
+        let mut rel = 0.0f32;
+        for (t, &w) in st.tone.iter_mut().zip(weights) {
+            *t = w;
+            rel += w / max;
+        }
+        st.tones = weights.len();
+        if rel > 1.0 / max {
+            // The weights sum to more than 1: divide by the sum (as `(w / max) / rel`).
+            for t in st.tone.iter_mut() {
+                *t = *t / max / rel;
             }
             st.neutral = 0.0;
         } else {
-            st.tone[..weights.len()].copy_from_slice(weights);
-            st.neutral = 1.0 - sum;
-        }
-        st.tones = weights.len();
-        if st.tone.iter().all(|&w| w == 0.0) {
-            return Ok(Self::NEUTRAL);
+            st.neutral = 1.0 - st.tone.iter().sum::<f32>();
         }
         Ok(st)
     }
