@@ -38,10 +38,12 @@ impl HalfBand {
         let mut sum = 0.0f64;
         for (m, c) in coef.iter_mut().enumerate() {
             let k = (2 * m + 1) as f64;
-            let sinc = libm::sin(core::f64::consts::PI * k / 2.0) / (core::f64::consts::PI * k);
+            // sin(pi k / 2) for odd k = 2m + 1 is (-1)^m.
+            let sign = if m % 2 == 0 { 1.0 } else { -1.0 };
+            let sinc = sign / (core::f64::consts::PI * k);
             // Blackman window over 32 points so that the outermost taps are not zero.
             let phase = 2.0 * core::f64::consts::PI * k / (TAPS as f64 + 1.0);
-            let w = 0.42 + 0.5 * libm::cos(phase) + 0.08 * libm::cos(2.0 * phase);
+            let w = 0.42 + 0.5 * super::window_cos(phase) + 0.08 * super::window_cos(2.0 * phase);
             let h = sinc * w;
             *c = h as f32;
             sum += 2.0 * h;
