@@ -102,6 +102,10 @@ pub enum Command {
         /// The style (tones of the blob).
         #[command(flatten)]
         style: StyleFlags,
+        /// Semantic labels at audio times: CSV with the header `time_s,label` (names of the
+        /// blob's labels).
+        #[arg(long, value_name = "CSV")]
+        labels: Option<PathBuf>,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
     /// utterance, and `run` on it (a few seconds after the build).
@@ -208,6 +212,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             bone_map,
             blender,
             style,
+            labels,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -221,6 +226,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 bone_map: bone_map.clone(),
                 blender: *blender,
                 style: style.clone(),
+                labels: labels.clone(),
             },
             out,
         ),

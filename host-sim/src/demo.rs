@@ -230,6 +230,7 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
             bone_map: None,
             blender: false,
             style: Default::default(),
+            labels: None,
         };
         line(
             out,

@@ -34,6 +34,7 @@ pub mod demo;
 pub mod error;
 pub mod eval;
 pub mod eval_cmd;
+pub mod labels;
 pub mod live;
 pub mod metrics_cmd;
 pub mod prosody_cmd;

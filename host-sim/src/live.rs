@@ -27,7 +27,7 @@ use std::io::Write;
 use std::time::Duration;
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent, LabelOutcome};
 use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::StepKind;
@@ -326,6 +326,27 @@ pub fn live_loop_with(
                         pose_err = on_pose(tick as f64 / fps.max(1e-9), pose).err();
                     }
                     Ok(())
+                }
+                ControllerEvent::Label {
+                    tick,
+                    label,
+                    outcome,
+                } => {
+                    let name = blob.label_names().nth(label).unwrap_or("?");
+                    let what = match outcome {
+                        LabelOutcome::Received => "received".to_string(),
+                        LabelOutcome::Entered { segment, frame } => {
+                            format!("answered by segment {segment} from frame {frame}")
+                        }
+                        LabelOutcome::Stroke => "stroke".to_string(),
+                        LabelOutcome::TimedOut => "dropped (timed out)".to_string(),
+                    };
+                    let line = format!("{:8.2} s  label {name}: {what}", tick as f64 / fps);
+                    if opts.redraw {
+                        writeln!(out, "\r\x1b[K{line}")
+                    } else {
+                        writeln!(out, "{line}")
+                    }
                 }
                 ControllerEvent::Frame(_) | ControllerEvent::Onset(_) => Ok(()),
             };

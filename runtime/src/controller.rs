@@ -51,9 +51,73 @@ use crate::inference::{
 };
 use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
 use crate::policy::{
-    select_styled, Choice, Decision, History, Penalties, PolicyTables, Style, StyleError, Variety,
-    Visit,
+    select_labelled, select_styled, Choice, Decision, History, Penalties, PolicyTables, Style,
+    StyleError, Variety, Visit,
 };
+
+/// Most semantic labels a blob defines.
+pub const MAX_LABELS: usize = 16;
+/// Most segments of a blob that carry a label.
+pub const MAX_LABELLED: usize = 64;
+/// Labels that can wait behind the one being served.
+pub const LABEL_QUEUE: usize = 4;
+
+/// Why a label was refused.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LabelError {
+    /// The blob has no label with this index.
+    Unknown {
+        /// The index given.
+        label: u32,
+        /// Labels of the blob.
+        labels: u32,
+    },
+    /// [`LABEL_QUEUE`] labels already wait.
+    QueueFull,
+}
+
+impl core::fmt::Display for LabelError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Self::Unknown { label, labels } => {
+                write!(f, "label {label} is not one of the blob's {labels} labels")
+            }
+            Self::QueueFull => write!(f, "{LABEL_QUEUE} labels already wait"),
+        }
+    }
+}
+
+impl core::error::Error for LabelError {}
+
+/// What became of a label ([`ControllerEvent::Label`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LabelOutcome {
+    /// The label reached the controller (it waits for the next exit point).
+    Received,
+    /// A segment carrying it was entered (at `frame`), or was already playing before its
+    /// stroke.
+    Entered {
+        /// The segment.
+        segment: usize,
+        /// The frame it was entered at.
+        frame: usize,
+    },
+    /// The stroke frame of that segment played: the label is served.
+    Stroke,
+    /// It waited longer than the blob's timeout and was dropped.
+    TimedOut,
+}
+
+/// The label being served.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct ActiveLabel {
+    /// Label index (0-based).
+    label: u8,
+    /// Tick it became active.
+    since: u64,
+    /// The segment entered for it and its stroke frame, once entered.
+    serving: Option<(usize, usize)>,
+}
 use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
 
 /// When the controller decides at exit points (see the module docs).
@@ -125,6 +189,15 @@ pub enum ControllerEvent<'a> {
     },
     /// A syllable onset was detected (its start frame, 10 ms frames as in [`Frame`]).
     Onset(u32),
+    /// A semantic label was received, answered by a segment, shown or dropped.
+    Label {
+        /// Animation tick (the tick due next, for `Received`).
+        tick: u64,
+        /// Label index (0-based).
+        label: usize,
+        /// What happened.
+        outcome: LabelOutcome,
+    },
 }
 
 /// Why a controller could not be built.
@@ -182,6 +255,7 @@ impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
         )?;
         me.timing = blob.timing();
         me.variety = blob.variety();
+        me.label_timeout_ms = blob.label_timeout_ms();
         let blend = me.ms_ticks(blob.blend_ms());
         me.player.set_blend_ticks(blend);
         Ok(me)
@@ -211,6 +285,13 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     history: History,
     /// The user's tone weights (neutral by default).
     style: Style,
+    /// The label being served, and those waiting behind it.
+    active_label: Option<ActiveLabel>,
+    label_queue: heapless::Deque<u8, LABEL_QUEUE>,
+    /// A label became active and its `Received` event is still to be reported.
+    label_received: bool,
+    /// A label not served within this long is dropped (ms; 0: never).
+    label_timeout_ms: u32,
     /// Belief the policy decides with instead of the CRF's (an evaluation's ablation).
     held_belief: Option<[f32; MAX_STATES]>,
     /// Ticks held at the current motion beat, waiting for an onset.
@@ -272,6 +353,10 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             variety: Variety::NONE,
             history: History::new(),
             style: Style::NEUTRAL,
+            active_label: None,
+            label_queue: heapless::Deque::new(),
+            label_received: false,
+            label_timeout_ms: 0,
             held_belief: None,
             holding: 0,
             last_onset: None,
@@ -363,6 +448,126 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
     /// The style in force.
     pub fn style(&self) -> &Style {
         &self.style
+    }
+
+    /// Asks for the semantic label `label` (0-based, the blob's order; docs/method.md
+    /// "Semantic labels"): from the next exit point on, the controller prefers the segments
+    /// carrying it and may enter one just before its stroke; the label is served once that
+    /// stroke plays, or dropped after the blob's timeout. A label that arrives while another
+    /// is served waits (at most [`LABEL_QUEUE`]). Reports `Received` through the next call's
+    /// events.
+    pub fn push_label(&mut self, label: usize) -> Result<(), LabelError> {
+        let labels = self.tables.labels();
+        if label >= labels {
+            return Err(LabelError::Unknown {
+                label: label.min(u32::MAX as usize) as u32,
+                labels: labels as u32,
+            });
+        }
+        if self.active_label.is_none() {
+            self.activate(label as u8);
+            Ok(())
+        } else {
+            self.label_queue
+                .push_back(label as u8)
+                .map_err(|_| LabelError::QueueFull)
+        }
+    }
+
+    /// Drops the label being served and every waiting one.
+    pub fn clear_labels(&mut self) {
+        self.active_label = None;
+        self.label_queue.clear();
+    }
+
+    /// The label being served (0-based), if any.
+    pub fn active_label(&self) -> Option<usize> {
+        self.active_label.map(|a| a.label as usize)
+    }
+
+    fn activate(&mut self, label: u8) {
+        self.active_label = Some(ActiveLabel {
+            label,
+            since: self.ticks,
+            serving: None,
+        });
+        self.label_received = true;
+    }
+
+    /// Whether a label waits for a segment (decisions then come at once).
+    fn label_waiting(&self) -> bool {
+        self.active_label.is_some_and(|a| a.serving.is_none())
+    }
+
+    /// Label bookkeeping after a tick that played `frame` of `segment` (`tick`): announces a
+    /// new label, serves it with the segment already playing if that carries it before its
+    /// stroke, reports its stroke or its timeout, and moves on to the next waiting label.
+    fn labels_after_tick(
+        &mut self,
+        tick: u64,
+        segment: usize,
+        frame: usize,
+        sink: &mut impl FnMut(ControllerEvent<'_>),
+    ) {
+        let Some(mut a) = self.active_label else {
+            return;
+        };
+        let label = a.label as usize;
+        if self.label_received {
+            self.label_received = false;
+            sink(ControllerEvent::Label {
+                tick: a.since,
+                label,
+                outcome: LabelOutcome::Received,
+            });
+            if self.tables.label_of(segment) == a.label + 1 {
+                if let Some(stroke) = self.tables.stroke_of(segment).filter(|&s| s >= frame) {
+                    a.serving = Some((segment, stroke));
+                    sink(ControllerEvent::Label {
+                        tick,
+                        label,
+                        outcome: LabelOutcome::Entered { segment, frame },
+                    });
+                }
+            }
+        }
+        let done = match a.serving {
+            Some((seg, stroke)) if seg == segment && frame >= stroke => {
+                sink(ControllerEvent::Label {
+                    tick,
+                    label,
+                    outcome: LabelOutcome::Stroke,
+                });
+                true
+            }
+            // The segment was left before its stroke (a cut decided for another reason):
+            // the label waits again.
+            Some((seg, _)) if seg != segment => {
+                a.serving = None;
+                false
+            }
+            Some(_) => false,
+            None => {
+                let timeout = self.ms_ticks(self.label_timeout_ms) as u64;
+                if timeout > 0 && tick.saturating_sub(a.since) >= timeout {
+                    sink(ControllerEvent::Label {
+                        tick,
+                        label,
+                        outcome: LabelOutcome::TimedOut,
+                    });
+                    true
+                } else {
+                    false
+                }
+            }
+        };
+        self.active_label = Some(a);
+        if done {
+            self.active_label = None;
+            if let Some(next) = self.label_queue.pop_front() {
+                self.activate(next);
+            }
+        }
     }
 
     /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
@@ -467,6 +672,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         let segment = self.player.segment();
         let t = self.timing;
         let fresh = !t.sync_to_onsets
+            || self.label_waiting()
             || self.last_onset.is_some_and(|o| {
                 !self.ticks_reach_ms(self.ticks.saturating_sub(o), t.onset_window_ms)
             });
@@ -504,8 +710,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             segment,
             frame: played,
         });
+        self.labels_after_tick(tick, segment, played, sink);
         let t = self.timing;
+        // A waiting label decides at the next exit point, onset or not.
         let fresh = !t.sync_to_onsets
+            || self.label_waiting()
             || self
                 .last_onset
                 .is_some_and(|o| !self.ticks_reach_ms(tick.saturating_sub(o), t.onset_window_ms));
@@ -588,9 +797,14 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             self.ms_ticks(self.variety.usage_ms),
         );
         let s = self.tables.states();
-        let decision = match &self.held_belief {
-            Some(h) => select_styled(self.tables, e, &h[..s], &penalties, &self.style),
-            None => select_styled(self.tables, e, self.belief(), &penalties, &self.style),
+        let b = match &self.held_belief {
+            Some(h) => &h[..s],
+            None => self.belief(),
+        };
+        let waiting = self.active_label.filter(|a| a.serving.is_none());
+        let decision = match waiting {
+            Some(a) => select_labelled(self.tables, e, b, &penalties, a.label as usize),
+            None => select_styled(self.tables, e, b, &penalties, &self.style),
         };
         match decision.choice {
             Choice::Continue => {
@@ -602,8 +816,24 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                 // The player ran on into the recorded successor while waiting: choosing it
                 // goes on without a cut; anything else (or no run-on) is a cut.
                 let ran_on = self.player.segment() != self.tables.exit_segment(e);
-                if !(ran_on && c == self.player.segment()) {
-                    self.player.enter(self.lib, c);
+                if !(ran_on && c == self.player.segment() && decision.entry_frame == 0) {
+                    self.player.enter_at(self.lib, c, decision.entry_frame);
+                }
+                if let Some(mut a) = waiting {
+                    if self.tables.label_of(c) == a.label + 1 {
+                        if let Some(stroke) = self.tables.stroke_of(c) {
+                            a.serving = Some((c, stroke));
+                            self.active_label = Some(a);
+                            sink(ControllerEvent::Label {
+                                tick,
+                                label: a.label as usize,
+                                outcome: LabelOutcome::Entered {
+                                    segment: c,
+                                    frame: decision.entry_frame,
+                                },
+                            });
+                        }
+                    }
                 }
                 self.history.write(Visit {
                     segment: c.min(u16::MAX as usize) as u16,

@@ -100,6 +100,42 @@ pub trait PolicyTables {
     fn tones(&self) -> usize {
         0
     }
+    /// Semantic labels L (0: none; the methods below are then never called).
+    fn labels(&self) -> usize {
+        0
+    }
+    /// Segment `c`'s label: `w + 1` for label `w`, 0 for none.
+    fn label_of(&self, _c: usize) -> u8 {
+        0
+    }
+    /// Segment `c`'s stroke frame, if it has one.
+    fn stroke_of(&self, _c: usize) -> Option<usize> {
+        None
+    }
+    /// Cost added to a candidate that does not carry the waiting label.
+    fn semantic_cost(&self) -> f32 {
+        0.0
+    }
+    /// Segments that carry a label.
+    fn labelled_count(&self) -> usize {
+        0
+    }
+    /// The `k`-th segment that carries a label.
+    fn labelled_segment(&self, _k: usize) -> usize {
+        0
+    }
+    /// `b . U^w(c)`: the cost-to-go of entering `c` while label `w` waits.
+    fn label_u_dot(&self, _w: usize, c: usize, b: &[f32]) -> f32 {
+        self.u_dot(c, b)
+    }
+    /// `b . U_cont^w(e)`.
+    fn label_u_cont_dot(&self, _w: usize, e: usize, b: &[f32]) -> f32 {
+        self.u_cont_dot(e, b)
+    }
+    /// The entry from exit `e` into the `k`-th labelled segment: `(frame, cost)`.
+    fn entry(&self, _e: usize, _k: usize) -> (usize, f32) {
+        (0, f32::INFINITY)
+    }
     /// `U^m(c, s)` of tone `m < tones()`.
     fn tone_u(&self, _m: usize, c: usize, s: usize) -> f32 {
         self.u(c, s)
@@ -270,7 +306,8 @@ impl Style {
 pub enum Choice {
     /// Keep playing the current segment.
     Continue,
-    /// Enter this segment at its first frame.
+    /// Enter this segment (at [`Decision::entry_frame`]: its first frame, or for a semantic
+    /// entry a frame before its stroke).
     Enter(usize),
 }
 
@@ -285,6 +322,8 @@ pub struct Decision {
     pub cost: f32,
     /// Candidates considered (successors plus continuing where allowed).
     pub candidates: usize,
+    /// The frame an entered segment starts at (0 but for semantic entries).
+    pub entry_frame: usize,
 }
 
 /// Variety costs (see the module docs); all zero: the paper's decision rule.
@@ -443,6 +482,7 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
         choice: Choice::Continue,
         cost: f32::INFINITY,
         candidates: 0,
+        entry_frame: 0,
     };
     if !t.exit_is_end(e) {
         best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(t.exit_segment(e));
@@ -455,6 +495,64 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
         if v < best.cost {
             best.cost = v;
             best.choice = Choice::Enter(c);
+        }
+    }
+    if t.exit_is_end(e) && best.choice == Choice::Continue {
+        best.choice = Choice::Enter(0);
+    }
+    best
+}
+
+/// [`select`] while label `w` (0-based) waits to be shown (docs/method.md "Semantic labels"):
+/// the value tables are the label's (`U^w`, `U_cont^w`: the cost-to-go while it waits, solved
+/// for the neutral tone, so no style applies), a candidate that does not carry `w` costs
+/// `t.semantic_cost()` more (continuing included), and every segment carrying `w` is also a
+/// candidate entered at its entry frame before the stroke, at the entry's cost plus its
+/// neutral `U` (the label is served from then on). Ties go as in [`select`], semantic entries
+/// last.
+pub fn select_labelled<T: PolicyTables + ?Sized>(
+    t: &T,
+    e: usize,
+    b: &[f32],
+    penalty: &Penalties,
+    w: usize,
+) -> Decision {
+    let code = (w + 1).min(u8::MAX as usize) as u8;
+    let sem = t.semantic_cost();
+    let other = |c: usize| if t.label_of(c) == code { 0.0 } else { sem };
+    let mut best = Decision {
+        exit: e,
+        choice: Choice::Continue,
+        cost: f32::INFINITY,
+        candidates: 0,
+        entry_frame: 0,
+    };
+    if !t.exit_is_end(e) {
+        let a = t.exit_segment(e);
+        best.cost = t.label_u_cont_dot(w, e, b) + penalty.usage_of(a) + other(a);
+        best.candidates = 1;
+    }
+    for k in 0..t.successor_count(e) {
+        let (c, sc) = t.successor(e, k);
+        let v = sc + t.label_u_dot(w, c, b) + penalty.of(c) + other(c);
+        best.candidates += 1;
+        if v < best.cost {
+            best.cost = v;
+            best.choice = Choice::Enter(c);
+        }
+    }
+    for k in 0..t.labelled_count() {
+        let c = t.labelled_segment(k);
+        if t.label_of(c) != code {
+            continue;
+        }
+        let (frame, ec) = t.entry(e, k);
+        let v = ec + t.u_dot(c, b) + penalty.of(c);
+        best.candidates += 1;
+        if v < best.cost {
+            best.cost = v;
+            best.choice = Choice::Enter(c);
+            best.entry_frame = frame;
         }
     }
     if t.exit_is_end(e) && best.choice == Choice::Continue {

@@ -60,6 +60,10 @@ const ALL: &[&str] = &[
     "BadDrive",
     "TooManyTones",
     "BadToneNames",
+    "TooManyLabels",
+    "BadLabelNames",
+    "BadLabelledSegment",
+    "EntryAfterStroke",
 ];
 
 #[test]
@@ -130,14 +134,14 @@ fn every_error_variant_is_reachable() {
             section: Section::FrontEnd,
         },
     );
-    // A byte after the last section (`styles`, absent).
+    // A byte after the last section (`labels`, absent).
     let mut b = good.clone();
     b.push(0);
     fix_crc(&mut b);
     check(
         &b,
         BlobError::Malformed {
-            section: Section::Styles,
+            section: Section::Labels,
         },
     );
     let mut b = good.clone();
@@ -149,8 +153,10 @@ fn every_error_variant_is_reachable() {
             section: Section::Skeleton,
         },
     );
+    // Without skeleton, styles and labels the payload ends `00 00 00`: cut those and two bytes
+    // of the rig.
     let mut b = mutated(&|t| t.skeleton = None);
-    b.truncate(b.len() - 3);
+    b.truncate(b.len() - 5);
     fix_crc(&mut b);
     check(
         &b,
@@ -694,6 +700,85 @@ fn every_error_variant_is_reachable() {
         &st(&|s| s.u_cont.0 = f32::NAN),
         BlobError::NotFinite {
             field: Field::ToneUCont,
+        },
+    );
+
+    // Labels: one on segment 1 (`bye`, stroke frame 1) is valid.
+    let lb = |f: &dyn Fn(&mut Tiny, &mut TinyLabels)| {
+        let mut t = Tiny::new();
+        let mut l = TinyLabels::one();
+        f(&mut t, &mut l);
+        t.label_section = Some(l);
+        t.encode()
+    };
+    let good_labels = lb(&|_, _| {});
+    let b = Blob::parse(&good_labels).unwrap();
+    assert_eq!((b.labels(), b.labelled_count()), (2, 1));
+    assert_eq!(b.label_names().collect::<Vec<_>>(), ["hello", "bye"]);
+    assert_eq!((b.label_of(1), b.label_of(0)), (2, 0));
+    assert_eq!(b.entry(2, 0), Some((1, 0.25)));
+    assert_eq!(b.entry(3, 0), None);
+    assert_eq!(b.label_timeout_ms(), 2000);
+    // Without a labels section the library's label bytes are ignored.
+    assert_eq!(Blob::parse(&good).unwrap().label_of(1), 0);
+    check(
+        &lb(&|_, l| l.labels = 0),
+        BlobError::ZeroCount {
+            field: Field::LabelCount,
+        },
+    );
+    check(
+        &lb(&|_, l| l.labels = 17),
+        BlobError::TooManyLabels { found: 17 },
+    );
+    check(
+        &lb(&|_, l| l.names = "hello\nhello".into()),
+        BlobError::BadLabelNames { label: 1 },
+    );
+    check(
+        &lb(&|_, l| l.semantic_cost = -1.0),
+        BlobError::BadControl {
+            field: Field::SemanticCost,
+        },
+    );
+    // Segment 1's label byte (2) is above a single label.
+    check(
+        &lb(&|_, l| {
+            l.labels = 1;
+            l.names = "bye".into();
+            l.u.1.truncate(8);
+            l.u_cont.1.truncate(12);
+        }),
+        BlobError::BadLabelledSegment { segment: 1 },
+    );
+    check(
+        &lb(&|_, l| l.segments = vec![0, 0]),
+        BlobError::BadLabelledSegment { segment: 1 },
+    );
+    check(
+        &lb(&|_, l| l.segments = vec![]),
+        BlobError::BadLabelledSegment { segment: 1 },
+    );
+    check(
+        &lb(&|_, l| l.entries[4] = 2),
+        BlobError::EntryAfterStroke { entry: 1 },
+    );
+    check(
+        &lb(&|_, l| {
+            l.entries.pop();
+        }),
+        BlobError::TableLength {
+            field: Field::LabelEntries,
+            expected: 12,
+            found: 11,
+        },
+    );
+    check(
+        &lb(&|_, l| l.u.1.extend([0, 0])),
+        BlobError::TableLength {
+            field: Field::LabelU,
+            expected: 16,
+            found: 18,
         },
     );
 

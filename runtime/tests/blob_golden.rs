@@ -39,10 +39,15 @@ fn golden_bytes_and_round_trip() {
             + sz.library
             + sz.rig
             + sz.skeleton
-            + sz.styles,
+            + sz.styles
+            + sz.labels,
         h.payload_len as usize
     );
-    assert_eq!(sz.styles, 1, "an absent styles section is postcard's None");
+    assert_eq!(
+        (sz.styles, sz.labels),
+        (1, 1),
+        "absent sections are postcard's None"
+    );
     assert_eq!(sz.front_end, postcard_len(&tiny.payload().front_end));
     assert_eq!(sz.rig, postcard_len(&tiny.payload().rig));
 

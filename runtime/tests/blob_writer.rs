@@ -125,6 +125,7 @@ fn constructors_round_trip_through_the_reader() {
             )
             .unwrap(),
         ),
+        labels: None,
     };
     let bytes = owned.encode().unwrap();
     let b = Blob::parse(&bytes).unwrap();
@@ -176,6 +177,55 @@ fn constructors_round_trip_through_the_reader() {
     // A line break in a name, or tables that do not match the names, are refused.
     assert!(OwnedStyles::new(&["a\nb"], &[vec![]], &[vec![]]).is_err());
     assert!(OwnedStyles::new(&["a", "b"], &[vec![]], &[vec![]]).is_err());
+}
+
+/// The labels writer: the example's segment 1 carries label 2 (`bye`) with its stroke at
+/// frame 1; entries from its 3 exit points.
+#[test]
+fn labels_are_written_and_read_back() {
+    let mut p = OwnedPayload::example();
+    let entries = vec![vec![(1usize, 0.5f64)], vec![(0, -0.25)], vec![(1, 0.0)]];
+    let input = LabelsInput {
+        names: &["hello", "bye"],
+        semantic_cost: 5.0,
+        timeout_ms: 2500,
+        segments: &[1],
+        u: &[vec![1.0, 2.0, 3.0, 4.0], vec![-4.0, -3.0, -2.0, -1.0]],
+        u_cont: &[vec![0.5; 6], vec![0.25; 6]],
+        entries: &entries,
+    };
+    p.labels = Some(OwnedLabels::new(&input).unwrap());
+    let bytes = p.encode().unwrap();
+    let b = Blob::parse(&bytes).unwrap();
+    assert_eq!(b.label_names().collect::<Vec<_>>(), ["hello", "bye"]);
+    assert_eq!((b.labels(), b.labelled_count(), b.label_of(1)), (2, 1, 2));
+    assert_eq!((b.semantic_cost(), b.label_timeout_ms()), (5.0, 2500));
+    let (f, c) = b.entry(0, 0).unwrap();
+    assert_eq!(f, 1);
+    near(c, 0.5, 0.5);
+    near(b.entry(1, 0).unwrap().1, -0.25, 0.5);
+    let belief = [1.0f32, 0.0];
+    near(b.label_u_dot(1, 1, &belief), -2.0, 4.0);
+    near(b.label_u_cont_dot(0, 2, &belief), 0.5, 0.5);
+    // Tables that do not match the names, rows of the wrong length, or an entry after the
+    // stroke are refused.
+    let mut i = input;
+    i.names = &["a"];
+    assert!(OwnedLabels::new(&i).is_err());
+    let short = vec![vec![], vec![], vec![]];
+    let mut i = input;
+    i.entries = &short;
+    assert!(OwnedLabels::new(&i).is_err());
+    let late = vec![vec![(2usize, 0.0f64)], vec![(0, 0.0)], vec![(0, 0.0)]];
+    let mut i = input;
+    i.entries = &late;
+    p.labels = Some(OwnedLabels::new(&i).unwrap());
+    assert!(matches!(
+        p.encode(),
+        Err(gesture_runtime::blob::encode::EncodeError::Invalid(
+            BlobError::EntryAfterStroke { entry: 0 }
+        ))
+    ));
 }
 
 #[test]

@@ -191,6 +191,7 @@ fn run_varied(
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
         }
         ControllerEvent::Onset(frame) => out.push(Rec::Onset(next_tick, frame)),
+        ControllerEvent::Label { .. } => {}
         ControllerEvent::Frame(_) => {}
     };
     for ch in audio.chunks(chunk.max(1)) {
@@ -343,7 +344,7 @@ fn new_in_builds_in_place_what_new_builds() {
         ControllerEvent::Step { step, belief } => {
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
         }
-        ControllerEvent::Onset(_) | ControllerEvent::Frame(_) => {}
+        ControllerEvent::Onset(_) | ControllerEvent::Frame(_) | ControllerEvent::Label { .. } => {}
     };
     for ch in audio.chunks(333) {
         c.push(ch, &mut sink);

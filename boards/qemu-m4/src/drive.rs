@@ -291,7 +291,7 @@ pub fn run(
             probe.event_begin(&ev);
             match ev {
                 ControllerEvent::Frame(_) => sum.frames += 1,
-                ControllerEvent::Onset(_) => {}
+                ControllerEvent::Onset(_) | ControllerEvent::Label { .. } => {}
                 ControllerEvent::Step { belief, .. } => {
                     sum.steps += 1;
                     sum.belief_hash = fnv(sum.belief_hash, belief);

@@ -222,7 +222,9 @@ impl Probe for Timing<'_> {
                 self.policy += since;
                 self.worst_decision = self.worst_decision.max(since);
             }
-            ControllerEvent::Pose { .. } | ControllerEvent::Onset(_) => {}
+            ControllerEvent::Pose { .. }
+            | ControllerEvent::Onset(_)
+            | ControllerEvent::Label { .. } => {}
         }
         self.last_event = t;
     }

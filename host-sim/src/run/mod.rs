@@ -75,6 +75,8 @@ pub struct RunConfig {
     pub blender: bool,
     /// The style and its changes over time ([`crate::style`]).
     pub style: crate::style::StyleFlags,
+    /// Semantic labels at audio times (`--labels CSV`; [`crate::labels`]).
+    pub labels: Option<PathBuf>,
 }
 
 /// Why `run` failed.
@@ -110,7 +112,7 @@ pub enum RunError {
     /// The audio file could not be loaded.
     #[error(transparent)]
     Audio(#[from] AudioError),
-    /// The style options do not fit the blob.
+    /// The style or label options do not fit the blob.
     #[error("{0}")]
     Style(String),
     /// The output path exists and is not a folder.
@@ -369,6 +371,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     inputs.extend(cfg.rig.as_deref());
     inputs.extend(cfg.bone_map.as_deref());
     inputs.extend(cfg.style.style_track.as_deref());
+    inputs.extend(cfg.labels.as_deref());
     gesture_trainer::output::refuse_inputs(&outputs, &inputs).map_err(RunError::from)?;
     let bytes = read_blob(&cfg.blob)?;
     let blob = Blob::parse(&bytes).map_err(|source| RunError::Blob {
@@ -378,6 +381,11 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     let (cals, period_us) = calibrations(&blob, &cfg.blob, cfg.rig.as_deref())?;
     let tones: Vec<&str> = blob.tone_names().collect();
     let styles = cfg.style.schedule(&tones).map_err(RunError::Style)?;
+    let label_names: Vec<&str> = blob.label_names().collect();
+    let labels = match &cfg.labels {
+        Some(p) => crate::labels::read_label_track(p, &label_names).map_err(RunError::Style)?,
+        None => Vec::new(),
+    };
     let rate = blob.prosody_config().sample_rate_hz;
     let pcm = load_wav_at(&cfg.audio, rate).map_err(RunError::from)?;
     let mut vmc = match &cfg.vmc {
@@ -396,6 +404,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
             realtime: cfg.realtime && vmc.is_none(),
         },
         &styles,
+        &labels,
     )
     .map_err(RunError::Sim)?;
     let audio_name = cfg.audio.display().to_string();
@@ -416,6 +425,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
                 |s| blob.segment(s).map_or(1, |x| x.len as usize),
             ),
             tones: &tones,
+            label_names: &label_names,
         },
         &pcm.samples,
         cfg.video.then_some(cfg.audio.as_path()),

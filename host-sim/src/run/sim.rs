@@ -15,7 +15,7 @@
 use std::time::{Duration, Instant};
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent, LabelOutcome};
 use gesture_runtime::device::{Device, DeviceEvent};
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::StepKind;
@@ -115,6 +115,42 @@ pub struct Simulation {
     pub wall_s: f64,
     /// The style changes applied, in time order (the first at time 0; neutral if none given).
     pub styles: Vec<StyleChange>,
+    /// The semantic labels given, in time order, and what became of them.
+    pub labels: Vec<LabelRecord>,
+}
+
+/// A semantic label to give the controller at an audio time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelPush {
+    /// Audio time (s).
+    pub time_s: f64,
+    /// Label index (the blob's order).
+    pub label: usize,
+    /// Where it came from (`track`, `keyword`, `key`).
+    pub source: String,
+}
+
+/// A label given to the controller and what became of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelRecord {
+    /// When it reached the controller (s, audio clock).
+    pub time_s: f64,
+    /// Label index.
+    pub label: usize,
+    /// Where it came from.
+    pub source: String,
+    /// Whether the controller took it in (not refused for a full queue).
+    pub accepted: bool,
+    /// Whether the controller has reported it received (it may wait behind another).
+    pub received: bool,
+    /// The segment entered for it, and the frame it was entered at.
+    pub segment: Option<(usize, usize)>,
+    /// When that segment was entered (s).
+    pub entered_s: Option<f64>,
+    /// When its stroke frame played (s).
+    pub stroke_s: Option<f64>,
+    /// It waited past the blob's timeout and was dropped.
+    pub timed_out: bool,
 }
 
 impl Simulation {
@@ -207,6 +243,7 @@ pub fn simulate(
     period_us: f32,
     opts: SimOptions,
     styles: &[StyleChange],
+    labels: &[LabelPush],
 ) -> Result<Simulation, String> {
     let mut slot = Box::new(None);
     let controller = BlobController::from_blob_in(&mut slot, blob).map_err(|e| e.to_string())?;
@@ -225,7 +262,14 @@ pub fn simulate(
     };
     let channels = blob.channels();
     let at = |c: &StyleChange| (c.time_s * rate as f64).round().max(0.0) as usize;
-    let cuts: Vec<usize> = styles.iter().map(at).collect();
+    let label_at = |l: &LabelPush| (l.time_s * rate as f64).round().max(0.0) as usize;
+    let mut cuts: Vec<usize> = styles
+        .iter()
+        .map(at)
+        .chain(labels.iter().map(label_at))
+        .collect();
+    cuts.sort_unstable();
+    let mut next_label = 0usize;
     let mut next_style = 0usize;
     let mut style = 0usize;
     let start = Instant::now();
@@ -239,6 +283,22 @@ pub fn simulate(
             sim.styles.push(styles[next_style].clone());
             style = sim.styles.len() - 1;
             next_style += 1;
+        }
+        while next_label < labels.len() && label_at(&labels[next_label]) <= a {
+            let l = &labels[next_label];
+            let accepted = device.controller_mut().push_label(l.label).is_ok();
+            sim.labels.push(LabelRecord {
+                time_s: a as f64 / rate as f64,
+                label: l.label,
+                source: l.source.clone(),
+                accepted,
+                received: false,
+                segment: None,
+                entered_s: None,
+                stroke_s: None,
+                timed_out: false,
+            });
+            next_label += 1;
         }
         let chunk = &samples[a..b];
         pushed += chunk.len();
@@ -334,6 +394,34 @@ fn record(
             sim.shown.push((segment, frame));
         }
         ControllerEvent::Onset(_) => {}
+        ControllerEvent::Label {
+            tick,
+            label,
+            outcome,
+        } => {
+            let t = tick as f64 / fps;
+            // The record this event is about: the first accepted one of this label not yet
+            // received (for `Received`), else the latest received and unfinished one.
+            let open = |r: &LabelRecord| {
+                r.label == label && r.accepted && r.stroke_s.is_none() && !r.timed_out
+            };
+            let k = match outcome {
+                LabelOutcome::Received => sim.labels.iter().position(|r| open(r) && !r.received),
+                _ => sim.labels.iter().rposition(|r| open(r) && r.received),
+            };
+            let Some(r) = k.and_then(|k| sim.labels.get_mut(k)) else {
+                return;
+            };
+            match outcome {
+                LabelOutcome::Received => r.received = true,
+                LabelOutcome::Entered { segment, frame } => {
+                    r.segment = Some((segment, frame));
+                    r.entered_s = Some(t);
+                }
+                LabelOutcome::Stroke => r.stroke_s = Some(t),
+                LabelOutcome::TimedOut => r.timed_out = true,
+            }
+        }
     }
 }
 

@@ -11,6 +11,9 @@
 //!                    "choice": "continue" | "enter", "segment" (entered, or null),
 //!                    "candidates", "cost", "style": { NAME: WEIGHT } } ],
 //!   "tones": [NAME...], "styles": [ { "time_s", "style": { NAME: WEIGHT } } ],
+//!   "labels": [ { "time_s", "label", "source", "segment", "entry_frame", "entered_s",
+//!                 "stroke_time_s", "outcome": "stroke" | "timed out" | "pending" |
+//!                 "refused (queue full)" } ],
 //!   "entries": [ { "tick", "time_s", "segment", "cut" } ],
 //!   "latency": { "syllables", "median_s", "max_s" } }
 //! ```
@@ -25,6 +28,9 @@
 //! `style` is the style in force at a decision: `neutral` and every tone with a weight above 0
 //! (the weights sum to 1); `styles` lists the changes given (`--style`, `--style-track`,
 //! `--energy`), the first at time 0; `tones` the blob's tones (empty for a blob without).
+//! `labels` are the semantic labels given (`--labels`): `time_s` when the label reached the
+//! controller, `segment` the labelled segment entered for it (null if none was), entered at
+//! `entry_frame` at `entered_s`, and `stroke_time_s` when its stroke frame played.
 
 use serde::Serialize;
 
@@ -52,12 +58,25 @@ pub struct Timeline<'a> {
     decisions: Vec<Decision>,
     tones: Vec<String>,
     styles: Vec<StyleRecord>,
+    labels: Vec<LabelEntry>,
     entries: Vec<EntryRecord>,
     latency: Latency,
 }
 
 /// A style as written: name to weight, `neutral` included.
 type StyleMap = std::collections::BTreeMap<String, f32>;
+
+#[derive(Debug, Serialize)]
+struct LabelEntry {
+    time_s: f64,
+    label: String,
+    source: String,
+    segment: Option<usize>,
+    entry_frame: Option<usize>,
+    entered_s: Option<f64>,
+    stroke_time_s: Option<f64>,
+    outcome: &'static str,
+}
 
 #[derive(Debug, Serialize)]
 struct StyleRecord {
@@ -132,6 +151,8 @@ pub struct Context<'a> {
     pub entries: &'a [Entry],
     /// The blob's tone names.
     pub tones: &'a [&'a str],
+    /// The blob's label names.
+    pub label_names: &'a [&'a str],
 }
 
 /// Rounds to 6 decimals so the file stays readable (microsecond times).
@@ -177,6 +198,31 @@ impl<'a> Timeline<'a> {
                 })
                 .collect(),
             tones: cx.tones.iter().map(|t| t.to_string()).collect(),
+            labels: sim
+                .labels
+                .iter()
+                .map(|l| LabelEntry {
+                    time_s: r6(l.time_s),
+                    label: cx
+                        .label_names
+                        .get(l.label)
+                        .map_or_else(|| l.label.to_string(), |n| n.to_string()),
+                    source: l.source.clone(),
+                    segment: l.segment.map(|s| s.0),
+                    entry_frame: l.segment.map(|s| s.1),
+                    entered_s: l.entered_s.map(r6),
+                    stroke_time_s: l.stroke_s.map(r6),
+                    outcome: if !l.accepted {
+                        "refused (queue full)"
+                    } else if l.stroke_s.is_some() {
+                        "stroke"
+                    } else if l.timed_out {
+                        "timed out"
+                    } else {
+                        "pending"
+                    },
+                })
+                .collect(),
             styles: sim
                 .styles
                 .iter()

@@ -685,6 +685,118 @@ impl OwnedStyles {
     }
 }
 
+/// Inputs of [`OwnedLabels::new`], in float.
+#[derive(Clone, Copy, Debug)]
+pub struct LabelsInput<'a> {
+    /// Label names (label `w` is `library.labels` value `w + 1`).
+    pub names: &'a [&'a str],
+    /// Cost added to candidates that do not carry the waiting label.
+    pub semantic_cost: f64,
+    /// A label not shown within this long is dropped (ms).
+    pub timeout_ms: u32,
+    /// The labelled segments, increasing.
+    pub segments: &'a [usize],
+    /// Per label, U^w (segments x S, segment-major).
+    pub u: &'a [Vec<f64>],
+    /// Per label, U_cont^w (exit points x S).
+    pub u_cont: &'a [Vec<f64>],
+    /// Per exit point, per labelled segment: `(entry frame, cost)`.
+    pub entries: &'a [Vec<(usize, f64)>],
+}
+
+/// Owned `labels` section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OwnedLabels {
+    /// Labels L.
+    pub labels: u8,
+    /// Names joined by `'\n'`.
+    pub names: String,
+    /// Semantic cost.
+    pub semantic_cost: f32,
+    /// Timeout (ms).
+    pub timeout_ms: u16,
+    /// `u16` per labelled segment.
+    pub segments: Vec<u8>,
+    /// U^w of every label, one scale.
+    pub u: QTable,
+    /// U_cont^w of every label.
+    pub u_cont: QTable,
+    /// Entry records.
+    pub entries: Vec<u8>,
+    /// Entry cost scale.
+    pub entry_cost_scale: f32,
+}
+
+impl OwnedLabels {
+    /// Quantizes and lays out the labels section (the format's rules are checked by
+    /// [`encode`]).
+    pub fn new(p: &LabelsInput<'_>) -> Result<Self, EncodeError> {
+        let l = p.names.len();
+        if p.u.len() != l || p.u_cont.len() != l {
+            return inconsistent(alloc::format!(
+                "{l} label names for {} U and {} U_cont tables",
+                p.u.len(),
+                p.u_cont.len()
+            ));
+        }
+        if let Some(n) = p.names.iter().find(|n| n.contains('\n')) {
+            return inconsistent(alloc::format!("label name {n:?} contains a line break"));
+        }
+        if let Some(r) = p.entries.iter().find(|r| r.len() != p.segments.len()) {
+            return inconsistent(alloc::format!(
+                "{} entries for {} labelled segments",
+                r.len(),
+                p.segments.len()
+            ));
+        }
+        let mut segments = Vec::with_capacity(2 * p.segments.len());
+        for &c in p.segments {
+            segments.extend(fit::<u16>("labelled segment", c, "u16")?.to_le_bytes());
+        }
+        let max = p
+            .entries
+            .iter()
+            .flatten()
+            .map(|&(_, c)| c)
+            .filter(|c| c.is_finite())
+            .fold(0.0f64, |m, c| m.max(c.abs()));
+        let q = Quantization::symmetric(max);
+        let mut entries = Vec::with_capacity(4 * p.entries.len() * p.segments.len());
+        for &(frame, cost) in p.entries.iter().flatten() {
+            entries.extend(fit::<u16>("entry frame", frame, "u16")?.to_le_bytes());
+            entries.extend(q.code(cost).to_le_bytes());
+        }
+        let flat_u: Vec<f64> = p.u.iter().flatten().copied().collect();
+        let flat_uc: Vec<f64> = p.u_cont.iter().flatten().copied().collect();
+        Ok(Self {
+            labels: fit("labels", l, "u8")?,
+            names: p.names.join("\n"),
+            semantic_cost: p.semantic_cost as f32,
+            timeout_ms: fit("label timeout (ms)", p.timeout_ms as usize, "u16")?,
+            segments,
+            u: QTable::quantize(&flat_u),
+            u_cont: QTable::quantize(&flat_uc),
+            entries,
+            entry_cost_scale: q.scale,
+        })
+    }
+
+    /// The wire form, borrowing from `self`.
+    pub fn section(&self) -> LabelsSection<'_> {
+        LabelsSection {
+            labels: self.labels,
+            names: &self.names,
+            semantic_cost: self.semantic_cost,
+            timeout_ms: self.timeout_ms,
+            segments: &self.segments,
+            u: self.u.section(),
+            u_cont: self.u_cont.section(),
+            entries: &self.entries,
+            entry_cost_scale: self.entry_cost_scale,
+        }
+    }
+}
+
 /// Everything a blob holds, owned.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OwnedPayload {
@@ -704,6 +816,8 @@ pub struct OwnedPayload {
     pub skeleton: Option<OwnedSkeleton>,
     /// Tones (optional).
     pub styles: Option<OwnedStyles>,
+    /// Semantic labels (optional).
+    pub labels: Option<OwnedLabels>,
 }
 
 impl OwnedPayload {
@@ -718,6 +832,7 @@ impl OwnedPayload {
             rig: self.rig.section(),
             skeleton: self.skeleton.as_ref().map(OwnedSkeleton::section),
             styles: self.styles.as_ref().map(OwnedStyles::section),
+            labels: self.labels.as_ref().map(OwnedLabels::section),
         }
     }
 
@@ -782,6 +897,7 @@ impl OwnedPayload {
                 rig,
                 skeleton: None,
                 styles: None,
+                labels: None,
             },
             _ => unreachable!("the example's fixed tables fit their fields"),
         }

@@ -25,6 +25,8 @@ pub enum Section {
     Skeleton,
     /// The optional tones (styles).
     Styles,
+    /// The optional semantic labels.
+    Labels,
 }
 
 impl Section {
@@ -39,6 +41,7 @@ impl Section {
             Self::Rig => "rig",
             Self::Skeleton => "skeleton",
             Self::Styles => "styles",
+            Self::Labels => "labels",
         }
     }
 }
@@ -142,6 +145,18 @@ pub enum Field {
     ToneU,
     /// `styles.u_cont`.
     ToneUCont,
+    /// `labels.labels`.
+    LabelCount,
+    /// `labels.segments`.
+    LabelSegments,
+    /// `labels.u`.
+    LabelU,
+    /// `labels.u_cont`.
+    LabelUCont,
+    /// `labels.entries`.
+    LabelEntries,
+    /// `labels.semantic_cost`.
+    SemanticCost,
 }
 
 impl Field {
@@ -193,6 +208,12 @@ impl Field {
             Self::ToneNames => "styles.names",
             Self::ToneU => "styles.u",
             Self::ToneUCont => "styles.u_cont",
+            Self::LabelCount => "labels.labels",
+            Self::LabelSegments => "labels.segments",
+            Self::LabelU => "labels.u",
+            Self::LabelUCont => "labels.u_cont",
+            Self::LabelEntries => "labels.entries",
+            Self::SemanticCost => "labels.semantic_cost",
         }
     }
 }
@@ -476,6 +497,28 @@ pub enum BlobError {
         /// extra).
         tone: u32,
     },
+    // --- labels ---
+    /// More labels than [`MAX_LABELS`](crate::controller::MAX_LABELS).
+    TooManyLabels {
+        /// Labels in the blob.
+        found: u32,
+    },
+    /// `labels.names` does not hold one distinct, non-empty name per label.
+    BadLabelNames {
+        /// The first bad label (or the label count when names are missing or extra).
+        label: u32,
+    },
+    /// A segment's label is above the label count, or `labels.segments` is not the increasing
+    /// list of exactly the labelled segments, each with a stroke.
+    BadLabelledSegment {
+        /// Segment index.
+        segment: u32,
+    },
+    /// A semantic entry's frame is past its segment's stroke frame.
+    EntryAfterStroke {
+        /// Entry record index.
+        entry: u32,
+    },
 }
 
 impl BlobError {
@@ -531,6 +574,10 @@ impl BlobError {
             Self::BadDrive { .. } => "BadDrive",
             Self::TooManyTones { .. } => "TooManyTones",
             Self::BadToneNames { .. } => "BadToneNames",
+            Self::TooManyLabels { .. } => "TooManyLabels",
+            Self::BadLabelNames { .. } => "BadLabelNames",
+            Self::BadLabelledSegment { .. } => "BadLabelledSegment",
+            Self::EntryAfterStroke { .. } => "EntryAfterStroke",
         }
     }
 }
@@ -740,7 +787,27 @@ impl fmt::Display for BlobError {
             ),
             Self::BadToneNames { tone } => write!(
                 f,
-                "styles.names: tone {tone} has no name, a repeated one or the reserved                  `neutral` (one distinct name per tone)"
+                "styles.names: tone {tone} has no name, a repeated one or the reserved \
+                 `neutral` (one distinct name per tone)"
+            ),
+            Self::TooManyLabels { found } => write!(
+                f,
+                "{found} labels, the runtime holds at most {} (pack fewer labels)",
+                crate::controller::MAX_LABELS
+            ),
+            Self::BadLabelNames { label } => write!(
+                f,
+                "labels.names: label {label} has no name or a repeated one (one distinct name \
+                 per label)"
+            ),
+            Self::BadLabelledSegment { segment } => write!(
+                f,
+                "segment {segment}: its label is out of range, or labels.segments does not list \
+                 exactly the labelled segments with strokes, in order"
+            ),
+            Self::EntryAfterStroke { entry } => write!(
+                f,
+                "labels.entries[{entry}] enters its segment after the stroke"
             ),
         }
     }

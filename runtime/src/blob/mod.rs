@@ -57,10 +57,11 @@ pub use crc::{crc32, Crc32};
 pub use error::{BlobError, Field, Section};
 pub use header::{Header, FORMAT_VERSION, HEADER_LEN, MAGIC};
 pub use payload::{
-    ControlSection, FrontEndSection, I16Section, InferenceSection, LibrarySection, Payload,
-    PolicySection, RigSection, SkeletonSection, StylesSection, CALIBRATION_RECORD_BYTES,
-    DRIVE_RECORD_BYTES, END_SITE_RECORD_BYTES, EXIT_RECORD_BYTES, FRAME_SCALE_RECORD_BYTES,
-    GMM_RECORD_BYTES, GROUP_RECORD_BYTES, NO_STROKE, ROOT_PARENT, SUCCESSOR_RECORD_BYTES,
+    ControlSection, FrontEndSection, I16Section, InferenceSection, LabelsSection, LibrarySection,
+    Payload, PolicySection, RigSection, SkeletonSection, StylesSection, CALIBRATION_RECORD_BYTES,
+    DRIVE_RECORD_BYTES, END_SITE_RECORD_BYTES, ENTRY_RECORD_BYTES, EXIT_RECORD_BYTES,
+    FRAME_SCALE_RECORD_BYTES, GMM_RECORD_BYTES, GROUP_RECORD_BYTES, NO_STROKE, ROOT_PARENT,
+    SUCCESSOR_RECORD_BYTES,
 };
 pub use quantize::{quantize_range, quantize_symmetric, Quantization, QUANT_MAX};
 pub use records::{calibration_from_record, calibration_record, gmm_from_record, gmm_record};

@@ -60,6 +60,46 @@ pub struct Payload<'a> {
     /// neutral policy only).
     #[serde(borrow)]
     pub styles: Option<StylesSection<'a>>,
+    /// Semantic labels: names, value tables while a label waits, entries before strokes
+    /// (absent: no labels; `library.labels` is then ignored).
+    #[serde(borrow)]
+    pub labels: Option<LabelsSection<'a>>,
+}
+
+/// Bytes of one semantic entry record (`frame: u16`, `cost: i16`).
+pub const ENTRY_RECORD_BYTES: usize = 4;
+
+/// Semantic labels (docs/method.md "Semantic labels", the paper's section 8.1): while label
+/// `w` waits to be shown, candidates that do not carry it cost `semantic_cost` more, the value
+/// tables are `U^w` (the cost-to-go while `w` waits), and a segment carrying `w` may also be
+/// entered at a frame before its stroke.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LabelsSection<'a> {
+    /// Labels L (1..=[`MAX_LABELS`](crate::controller::MAX_LABELS)); `library.labels` holds
+    /// `1..=L` (0: none).
+    pub labels: u8,
+    /// L label names separated by `'\n'` (non-empty, distinct).
+    pub names: &'a str,
+    /// Added to the cost of a candidate that does not carry the waiting label (cost units).
+    pub semantic_cost: f32,
+    /// A label not shown within this long is dropped (ms).
+    pub timeout_ms: u16,
+    /// `u16` per labelled segment N: the segments carrying a label, increasing; each has a
+    /// stroke frame.
+    #[serde(borrow)]
+    pub segments: &'a [u8],
+    /// U^w(a', s) of every label: L x segments x S, label-major then as `policy.u`.
+    #[serde(borrow)]
+    pub u: I16Section<'a>,
+    /// U_cont^w(e, s) of every label: L x exit points x S.
+    #[serde(borrow)]
+    pub u_cont: I16Section<'a>,
+    /// Per exit point, per labelled segment (in `segments` order): `frame: u16` (the entry frame,
+    /// at most the stroke frame), `cost: i16` (cost = `i16 * entry_cost_scale`): E x N records.
+    #[serde(borrow)]
+    pub entries: &'a [u8],
+    /// Multiplier of the entry costs.
+    pub entry_cost_scale: f32,
 }
 
 /// The prosody front-end's settings ([`ProsodyConfig`], flattened).

@@ -52,6 +52,33 @@ impl PolicyTables for Blob<'_> {
     fn tones(&self) -> usize {
         Blob::tones(self)
     }
+    fn labels(&self) -> usize {
+        Blob::labels(self)
+    }
+    fn label_of(&self, c: usize) -> u8 {
+        Blob::label_of(self, c)
+    }
+    fn stroke_of(&self, c: usize) -> Option<usize> {
+        self.segment(c).and_then(|s| s.stroke).map(usize::from)
+    }
+    fn semantic_cost(&self) -> f32 {
+        Blob::semantic_cost(self)
+    }
+    fn labelled_count(&self) -> usize {
+        Blob::labelled_count(self)
+    }
+    fn labelled_segment(&self, k: usize) -> usize {
+        Blob::labelled_segment(self, k).unwrap_or(0)
+    }
+    fn label_u_dot(&self, w: usize, c: usize, b: &[f32]) -> f32 {
+        Blob::label_u_dot(self, w, c, b)
+    }
+    fn label_u_cont_dot(&self, w: usize, e: usize, b: &[f32]) -> f32 {
+        Blob::label_u_cont_dot(self, w, e, b)
+    }
+    fn entry(&self, e: usize, k: usize) -> (usize, f32) {
+        Blob::entry(self, e, k).unwrap_or((0, f32::INFINITY))
+    }
     fn tone_u(&self, m: usize, c: usize, s: usize) -> f32 {
         Blob::tone_u(self, m, c, s)
     }

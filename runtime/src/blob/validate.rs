@@ -22,6 +22,8 @@ pub(super) struct Validated<'a> {
     pub u_cont: I16Table<'a>,
     pub tone_u: I16Table<'a>,
     pub tone_u_cont: I16Table<'a>,
+    pub label_u: I16Table<'a>,
+    pub label_u_cont: I16Table<'a>,
 }
 
 pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
@@ -38,13 +40,109 @@ pub(super) fn payload<'a>(p: &Payload<'a>) -> Result<Validated<'a>, BlobError> {
         Some(st) => styles(st, &p.policy)?,
         None => (I16Table::EMPTY, I16Table::EMPTY),
     };
+    let (label_u, label_u_cont) = match &p.labels {
+        Some(lb) => labels(lb, &p.policy, &p.library)?,
+        None => (I16Table::EMPTY, I16Table::EMPTY),
+    };
     Ok(Validated {
         crf,
         u,
         u_cont,
         tone_u,
         tone_u_cont,
+        label_u,
+        label_u_cont,
     })
+}
+
+/// `names` split on `'\n'` holds exactly `n` distinct non-empty names, none equal to
+/// `reserved`; otherwise the index of the first bad one (`n` when there are more).
+fn names_ok(names: &str, n: usize, reserved: &str) -> Result<(), u32> {
+    let mut it = names.split('\n');
+    for k in 0..n {
+        let name = it.next().ok_or(k as u32)?;
+        if name.is_empty() || name == reserved || names.split('\n').take(k).any(|x| x == name) {
+            return Err(k as u32);
+        }
+    }
+    match it.next() {
+        Some(_) => Err(n as u32),
+        None => Ok(()),
+    }
+}
+
+/// The labels section: the label count, names and cost; `labels.segments` is the increasing
+/// list of exactly the segments whose `library.labels` byte is not 0 (each at most L, each with
+/// a stroke, at most [`MAX_LABELLED`](crate::controller::MAX_LABELLED)); value tables of L
+/// times the policy's shapes; E x N entry records, each frame at most its segment's stroke.
+fn labels<'a>(
+    lb: &LabelsSection<'a>,
+    policy: &PolicySection<'a>,
+    lib: &LibrarySection<'_>,
+) -> Result<(I16Table<'a>, I16Table<'a>), BlobError> {
+    let l = lb.labels as usize;
+    count(
+        l,
+        crate::controller::MAX_LABELS,
+        Field::LabelCount,
+        BlobError::TooManyLabels { found: l as u32 },
+    )?;
+    names_ok(lb.names, l, "").map_err(|label| BlobError::BadLabelNames { label })?;
+    if !(lb.semantic_cost.is_finite() && (0.0..=MAX_VARIETY_COST).contains(&lb.semantic_cost)) {
+        return Err(BlobError::BadControl {
+            field: Field::SemanticCost,
+        });
+    }
+    if lb.segments.len() % 2 != 0 {
+        return Err(BlobError::TableLength {
+            field: Field::LabelSegments,
+            expected: lb.segments.len() + 1,
+            found: lb.segments.len(),
+        });
+    }
+    let n = lb.segments.len() / 2;
+    let segs = lib.segments as usize;
+    let mut k = 0usize;
+    for seg in 0..segs {
+        let lab = lib.labels.get(seg).copied().unwrap_or(0) as usize;
+        if lab == 0 {
+            continue;
+        }
+        let stroke = u16_at(lib.strokes, seg).unwrap_or(NO_STROKE);
+        if lab > l
+            || stroke == NO_STROKE
+            || k >= crate::controller::MAX_LABELLED
+            || u16_at(lb.segments, k) != Some(seg as u16)
+        {
+            return Err(BlobError::BadLabelledSegment {
+                segment: seg as u32,
+            });
+        }
+        k += 1;
+    }
+    if k != n {
+        return Err(BlobError::BadLabelledSegment {
+            segment: segs as u32,
+        });
+    }
+    let s = policy.states as usize;
+    let e = policy.exit_points as usize;
+    let u = i16_table(Field::LabelU, &lb.u, l * segs * s)?;
+    let uc = i16_table(Field::LabelUCont, &lb.u_cont, l * e * s)?;
+    length(Field::LabelEntries, lb.entries, e * n, ENTRY_RECORD_BYTES)?;
+    if !scale_ok(lb.entry_cost_scale) {
+        return Err(BlobError::NotFinite {
+            field: Field::LabelEntries,
+        });
+    }
+    for (i, r) in lb.entries.chunks_exact(ENTRY_RECORD_BYTES).enumerate() {
+        let frame = u16::from_le_bytes([r[0], r[1]]);
+        let seg = u16_at(lb.segments, i % n.max(1)).unwrap_or(0) as usize;
+        if frame > u16_at(lib.strokes, seg).unwrap_or(0) {
+            return Err(BlobError::EntryAfterStroke { entry: i as u32 });
+        }
+    }
+    Ok((u, uc))
 }
 
 /// The styles section: a tone count within the capacity, one distinct non-empty name per tone
@@ -60,17 +158,7 @@ fn styles<'a>(
         Field::Tones,
         BlobError::TooManyTones { found: m as u32 },
     )?;
-    let mut names = st.names.split('\n');
-    for k in 0..m {
-        let bad = BlobError::BadToneNames { tone: k as u32 };
-        let name = names.next().ok_or(bad)?;
-        if name.is_empty() || name == "neutral" || st.names.split('\n').take(k).any(|n| n == name) {
-            return Err(bad);
-        }
-    }
-    if names.next().is_some() {
-        return Err(BlobError::BadToneNames { tone: m as u32 });
-    }
+    names_ok(st.names, m, "neutral").map_err(|tone| BlobError::BadToneNames { tone })?;
     let s = policy.states as usize;
     let u = i16_table(Field::ToneU, &st.u, m * policy.segments as usize * s)?;
     let uc = i16_table(

@@ -42,6 +42,8 @@ pub struct SectionSizes {
     pub skeleton: usize,
     /// `styles` (1 byte when absent).
     pub styles: usize,
+    /// `labels` (1 byte when absent).
+    pub labels: usize,
 }
 
 /// An exit point: a frame of a segment where the policy may switch.
@@ -139,6 +141,8 @@ pub struct Blob<'a> {
     u_cont: I16Table<'a>,
     tone_u: I16Table<'a>,
     tone_u_cont: I16Table<'a>,
+    label_u: I16Table<'a>,
+    label_u_cont: I16Table<'a>,
 }
 
 impl<'a> Blob<'a> {
@@ -157,6 +161,8 @@ impl<'a> Blob<'a> {
             u_cont: v.u_cont,
             tone_u: v.tone_u,
             tone_u_cont: v.tone_u_cont,
+            label_u: v.label_u,
+            label_u_cont: v.label_u_cont,
         })
     }
 
@@ -603,6 +609,94 @@ impl<'a> Blob<'a> {
         self.tone_u_cont
             .get((tone * self.exit_points() + exit) * self.states() + state)
     }
+
+    // --- labels ---
+
+    /// Semantic labels L (0 without a `labels` section).
+    pub fn labels(&self) -> usize {
+        self.payload.labels.map_or(0, |l| l.labels as usize)
+    }
+
+    /// Label names in order (label `w` is `library.labels` value `w + 1`; empty without).
+    pub fn label_names(&self) -> core::str::Split<'a, char> {
+        let names = self.payload.labels.map_or("", |l| l.names);
+        let mut it = names.split('\n');
+        if names.is_empty() {
+            it.next();
+        }
+        it
+    }
+
+    /// The index of the label named `name`.
+    pub fn label_index(&self, name: &str) -> Option<usize> {
+        self.label_names().position(|n| n == name)
+    }
+
+    /// Cost added to candidates that do not carry the waiting label (0 without labels).
+    pub fn semantic_cost(&self) -> f32 {
+        self.payload.labels.map_or(0.0, |l| l.semantic_cost)
+    }
+
+    /// How long a label may wait to be shown (ms; 0 without labels).
+    pub fn label_timeout_ms(&self) -> u32 {
+        self.payload.labels.map_or(0, |l| l.timeout_ms as u32)
+    }
+
+    /// Labelled segments N.
+    pub fn labelled_count(&self) -> usize {
+        self.payload.labels.map_or(0, |l| l.segments.len() / 2)
+    }
+
+    /// The `k`-th labelled segment (`None` out of range).
+    pub fn labelled_segment(&self, k: usize) -> Option<usize> {
+        u16_at(self.payload.labels?.segments, k).map(usize::from)
+    }
+
+    /// The label of segment `c`: `w + 1` for label `w`, 0 for none (and without a `labels`
+    /// section, whatever `library.labels` holds).
+    pub fn label_of(&self, c: usize) -> u8 {
+        if self.payload.labels.is_none() {
+            return 0;
+        }
+        self.payload.library.labels.get(c).copied().unwrap_or(0)
+    }
+
+    /// `b . U^w(segment)` of label `w` (0-based), like [`u_dot`](Self::u_dot).
+    #[inline]
+    pub fn label_u_dot(&self, w: usize, segment: usize, b: &[f32]) -> f32 {
+        let s = self.states();
+        if w >= self.labels() || segment >= self.segments() {
+            return 0.0;
+        }
+        self.label_u
+            .dot((w * self.segments() + segment) * s, &b[..b.len().min(s)])
+    }
+
+    /// `b . U_cont^w(exit)` of label `w`, like [`u_dot`](Self::u_dot).
+    #[inline]
+    pub fn label_u_cont_dot(&self, w: usize, exit: usize, b: &[f32]) -> f32 {
+        let s = self.states();
+        if w >= self.labels() || exit >= self.exit_points() {
+            return 0.0;
+        }
+        self.label_u_cont
+            .dot((w * self.exit_points() + exit) * s, &b[..b.len().min(s)])
+    }
+
+    /// The semantic entry from exit `exit` into the `k`-th labelled segment: its entry frame
+    /// and cost (`None` out of range).
+    pub fn entry(&self, exit: usize, k: usize) -> Option<(usize, f32)> {
+        let l = self.payload.labels?;
+        let n = l.segments.len() / 2;
+        if k >= n {
+            return None;
+        }
+        let r = record::<ENTRY_RECORD_BYTES>(l.entries, exit.checked_mul(n)?.checked_add(k)?)?;
+        Some((
+            u16::from_le_bytes([r[0], r[1]]) as usize,
+            i16::from_le_bytes([r[2], r[3]]) as f32 * l.entry_cost_scale,
+        ))
+    }
 }
 
 /// Decodes the sections one after the other, recording their encoded sizes. Postcard encodes a
@@ -627,9 +721,10 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
     let (rig, rg) = take(&mut rest, Section::Rig)?;
     let (skeleton, sk) = take(&mut rest, Section::Skeleton)?;
     let (styles, st) = take(&mut rest, Section::Styles)?;
+    let (labels, lb) = take(&mut rest, Section::Labels)?;
     if !rest.is_empty() {
         return Err(BlobError::Malformed {
-            section: Section::Styles,
+            section: Section::Labels,
         });
     }
     Ok((
@@ -642,6 +737,7 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
             rig,
             skeleton,
             styles,
+            labels,
         },
         SectionSizes {
             front_end: fe,
@@ -652,6 +748,7 @@ fn decode(body: &[u8]) -> Result<(Payload<'_>, SectionSizes), BlobError> {
             rig: rg,
             skeleton: sk,
             styles: st,
+            labels: lb,
         },
     ))
 }

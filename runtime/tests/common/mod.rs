@@ -74,6 +74,69 @@ pub struct Tiny {
     pub skeleton: Option<TinySkeleton>,
     /// Tones: count, names, U (scale, bytes), U_cont (scale, bytes).
     pub styles: Option<TinyStyles>,
+    /// Semantic labels section.
+    pub label_section: Option<TinyLabels>,
+}
+
+/// The tiny blob's labels (none by default; [`TinyLabels::one`] gives one on segment 1, whose
+/// stroke is frame 1 and whose `library.labels` byte is 2 in the tiny blob, so label names
+/// must number two).
+#[derive(Clone, Debug)]
+pub struct TinyLabels {
+    pub labels: u8,
+    pub names: String,
+    pub semantic_cost: f32,
+    pub timeout_ms: u16,
+    pub segments: Vec<u8>,
+    pub u: (f32, Vec<u8>),
+    pub u_cont: (f32, Vec<u8>),
+    pub entries: Vec<u8>,
+    pub entry_cost_scale: f32,
+}
+
+impl TinyLabels {
+    /// Labels `hello` and `bye` (segment 1 carries `bye`, stroke frame 1), semantic cost 5,
+    /// timeout 2 s; U^w = 1, 2, 3, 4 for both labels (2 segments x 2 states), U_cont^w = 0.5
+    /// (3 exits x 2 states); entries from every exit into segment 1 at frame 1, cost 0.25.
+    pub fn one() -> Self {
+        let u: Vec<u8> = [1i16, 2, 3, 4, 1, 2, 3, 4]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let u_cont: Vec<u8> = [1i16; 12].iter().flat_map(|v| v.to_le_bytes()).collect();
+        let entries: Vec<u8> = (0..3).flat_map(|_| [1u8, 0, 1, 0]).collect();
+        Self {
+            labels: 2,
+            names: "hello\nbye".into(),
+            semantic_cost: 5.0,
+            timeout_ms: 2000,
+            segments: vec![1, 0],
+            u: (1.0, u),
+            u_cont: (0.5, u_cont),
+            entries,
+            entry_cost_scale: 0.25,
+        }
+    }
+
+    pub fn section(&self) -> LabelsSection<'_> {
+        LabelsSection {
+            labels: self.labels,
+            names: &self.names,
+            semantic_cost: self.semantic_cost,
+            timeout_ms: self.timeout_ms,
+            segments: &self.segments,
+            u: I16Section {
+                scale: self.u.0,
+                bytes: &self.u.1,
+            },
+            u_cont: I16Section {
+                scale: self.u_cont.0,
+                bytes: &self.u_cont.1,
+            },
+            entries: &self.entries,
+            entry_cost_scale: self.entry_cost_scale,
+        }
+    }
 }
 
 /// The tiny blob's tones (none by default; [`TinyStyles::two`] gives two).
@@ -226,6 +289,7 @@ impl Tiny {
             channel_names: "head".into(),
             skeleton: Some(TinySkeleton::new()),
             styles: None,
+            label_section: None,
         }
     }
 
@@ -283,6 +347,7 @@ impl Tiny {
             },
             skeleton: self.skeleton.as_ref().map(TinySkeleton::section),
             styles: self.styles.as_ref().map(TinyStyles::section),
+            labels: self.label_section.as_ref().map(TinyLabels::section),
         }
     }
 
@@ -317,14 +382,13 @@ pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-/// The tiny blob's bytes (format version 5: `styles` absent, the final `00`; the `control`
-/// section after
-/// `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601`; the
+/// The tiny blob's bytes (format version 5: `styles` and `labels` absent, the final `00 00`;
+/// the `control` section after `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601`; the
 /// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4) and no `groups`,
 /// `00`). Changing the format changes
 /// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(
-    "4753544205000000cb010000eac946e6807d00009642000016448fc2f53c6666",
+    "4753544205000000cc01000022a23b92807d00009642000016448fc2f53c6666",
     "e63e0ad7233c3333b33e295c0f3e000000400000c8410000c84100008c420619",
     "02010134000000bf000080bf0000803e0000c0bf000000400000003f00008040",
     "0000a0bf0000003e0000003f000080be000000410000c03f0ad7233c0464009c",
@@ -338,7 +402,7 @@ pub const GOLDEN: &str = concat!(
     "007a430468656164010209686970730a6865616404ffff000018000000000000",
     "0000000000000000000000002041000000000206030900010205030405030424",
     "000000000000b442000000000000000000000000000000000000000000000000",
-    "000000000e0100000000000000a040000000000601000100010100",
+    "000000000e0100000000000000a04000000000060100010001010000",
 );
 
 pub fn postcard_len<T: serde::Serialize>(v: &T) -> usize {

@@ -391,3 +391,121 @@ impl StyleArgs {
         Ok(o)
     }
 }
+
+/// Semantic labels to pack (`pack`; docs/method.md "Semantic labels").
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct LabelArgs {
+    /// A label and the library files that carry it, as NAME=PATTERN on file names (e.g.
+    /// `'bye=*_bye_*'`); repeatable. The stroke is the clip's hand-speed peak.
+    #[arg(long = "label", value_name = "NAME=PATTERN")]
+    pub label: Vec<String>,
+    /// Labels from a CSV file with the header `pattern,label,stroke_s` (`stroke_s`, the stroke's
+    /// time in the clip, may be empty: the hand-speed peak).
+    #[arg(long, value_name = "CSV")]
+    pub label_file: Option<std::path::PathBuf>,
+    /// Cost of every decision that does not serve a waiting label.
+    #[arg(long, default_value_t = crate::control::semantic::LabelParams::default().semantic_cost, value_parser = weight)]
+    pub semantic_cost: f64,
+    /// A label not shown within this long is dropped (ms).
+    #[arg(long, default_value_t = crate::control::semantic::LabelParams::default().timeout_ms, value_parser = |s: &str| count(s, 100, 60_000).map(|v| v as u32))]
+    pub label_timeout_ms: u32,
+    /// Enter a labelled gesture at its first frame only (no jump toward the stroke).
+    #[arg(long)]
+    pub no_stroke_entry: bool,
+}
+
+impl LabelArgs {
+    /// The label specs and settings, every name checked and the label file read.
+    pub fn options(
+        &self,
+    ) -> Result<
+        (
+            Vec<crate::control::semantic::LabelSpec>,
+            crate::control::semantic::LabelParams,
+        ),
+        CliError,
+    > {
+        use crate::control::semantic::{LabelParams, LabelSpec};
+        let mut specs = Vec::new();
+        let name_ok = |name: &str, what: &str| -> Result<(), CliError> {
+            if (1..=32).contains(&name.len())
+                && name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+            {
+                Ok(())
+            } else {
+                Err(CliError::Input(format!(
+                    "{what}: `{name}` cannot name a label (1-32 letters, digits, - or _)"
+                )))
+            }
+        };
+        for spec in &self.label {
+            let (name, pattern) = spec.split_once('=').ok_or_else(|| {
+                CliError::Input(format!(
+                    "--label {spec}: expected NAME=PATTERN (e.g. 'bye=*_bye_*')"
+                ))
+            })?;
+            name_ok(name, &format!("--label {spec}"))?;
+            glob::Pattern::new(pattern)
+                .map_err(|e| CliError::Input(format!("--label {spec}: bad pattern: {e}")))?;
+            specs.push(LabelSpec {
+                name: name.into(),
+                pattern: pattern.into(),
+                stroke_s: None,
+            });
+        }
+        if let Some(path) = &self.label_file {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+            let mut lines = text.lines().enumerate();
+            match lines.next() {
+                Some((_, h)) if h.trim().starts_with("pattern") => {}
+                _ => {
+                    return Err(CliError::Input(format!(
+                        "{}:1: expected the header `pattern,label,stroke_s`",
+                        path.display()
+                    )))
+                }
+            }
+            for (i, line) in lines {
+                let what = format!("{}:{}", path.display(), i + 1);
+                if line.trim().is_empty() || line.trim_start().starts_with('#') {
+                    continue;
+                }
+                let f: Vec<&str> = line.split(',').map(str::trim).collect();
+                if f.len() < 2 || f.len() > 3 {
+                    return Err(CliError::Input(format!(
+                        "{what}: expected `pattern,label,stroke_s`"
+                    )));
+                }
+                name_ok(f[1], &what)?;
+                glob::Pattern::new(f[0])
+                    .map_err(|e| CliError::Input(format!("{what}: bad pattern: {e}")))?;
+                let stroke_s = match f.get(2) {
+                    Some(v) if !v.is_empty() => Some(
+                        v.parse::<f64>()
+                            .ok()
+                            .filter(|t| t.is_finite() && *t >= 0.0)
+                            .ok_or_else(|| {
+                                CliError::Input(format!("{what}: `{v}` is not a time in seconds"))
+                            })?,
+                    ),
+                    _ => None,
+                };
+                specs.push(LabelSpec {
+                    name: f[1].into(),
+                    pattern: f[0].into(),
+                    stroke_s,
+                });
+            }
+        }
+        let params = LabelParams {
+            semantic_cost: self.semantic_cost,
+            timeout_ms: self.label_timeout_ms,
+            stroke_entry: !self.no_stroke_entry,
+            ..LabelParams::default()
+        };
+        Ok((specs, params))
+    }
+}

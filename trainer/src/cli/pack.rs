@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::args::{ControlArgs, CorpusArgs, DeviceArgs, StyleArgs};
+use super::args::{ControlArgs, CorpusArgs, DeviceArgs, LabelArgs, StyleArgs};
 use super::CliError;
 use crate::output::write_atomic;
 use crate::pack::{pack, PackOptions};
@@ -43,6 +43,9 @@ pub struct PackArgs {
     /// Tones mixed at run time.
     #[command(flatten)]
     pub styles: StyleArgs,
+    /// Semantic labels.
+    #[command(flatten)]
+    pub labels: LabelArgs,
 }
 
 /// Runs the command.
@@ -50,7 +53,9 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     // No output may be an input (the model, the rig, a library file) or the other output.
     let mut inputs: Vec<std::path::PathBuf> = vec![a.model.clone()];
     inputs.extend(a.rig.clone());
+    inputs.extend(a.labels.label_file.clone());
     let styles = a.styles.options()?;
+    let (labels, label_params) = a.labels.options()?;
     inputs.extend(styles.neutral.iter().cloned());
     inputs.extend(styles.tones.iter().flat_map(|(_, f)| f.iter().cloned()));
     if let Ok(takes) = crate::corpus::discover(&a.library) {
@@ -76,6 +81,8 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     a.device.validate()?;
     let mut opts = PackOptions {
         styles,
+        labels,
+        label_params,
         control: a.control.params(),
         rig: a.rig.clone(),
         budget_bytes: a.budget_bytes,
@@ -87,7 +94,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
     let r = pack(&a.model, &a.library, &opts, &a.out)?;
     outln!(
         "wrote {}: {} bytes (front-end {}, inference {}, policy {}, control {}, library {}, \
-         rig {}, skeleton {}, styles {})",
+         rig {}, skeleton {}, styles {}, labels {})",
         a.out.display(),
         r.blob_bytes,
         r.section_bytes.front_end,
@@ -97,7 +104,8 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.section_bytes.library,
         r.section_bytes.rig,
         r.section_bytes.skeleton,
-        r.section_bytes.styles
+        r.section_bytes.styles,
+        r.section_bytes.labels
     )?;
     outln!(
         "library: {} segments, {} exit points, {} frames; rig {} ({} channels)",
@@ -124,6 +132,16 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         100.0 * r.agreement,
         r.regret_decisions
     )?;
+    for l in &r.labels {
+        outln!(
+            "label {}: {} (segment {}, stroke at frame {}, entered from frame {} at the latest)",
+            l.label,
+            l.clip,
+            l.segment,
+            l.stroke_frame,
+            l.max_entry_frame
+        )?;
+    }
     for t in &r.styles {
         let f = t.factors;
         outln!(

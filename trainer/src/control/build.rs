@@ -2,7 +2,7 @@
 //! with the regret it costs (what `gesture-train pack` runs).
 //!
 //! The regret is measured on the policy as the device reads it: the tables of the packed blob
-//! (the runtime's [`PolicyTables`]), deciding through the runtime's own [`select`].
+//! (the runtime's [`PolicyTables`]), deciding through the runtime's own [`select_styled`].
 //! Regret is measured on simulated belief traces: a hidden state path drawn from the CRF's
 //! transition matrix, observed through a noisy channel (the true state gets 60% of the
 //! likelihood), filtered into beliefs; the controller walks the library following the
@@ -18,8 +18,9 @@ use rand_chacha::ChaCha8Rng;
 
 use super::costs::{psi, psi_of, successor_costs, CostParams, Signatures};
 use super::library::Library;
-use super::mdp::{solve, transition_matrix, Action, MdpParams, Policy};
+use super::mdp::{solve, solve_label, transition_matrix, Action, LabelProblem, MdpParams, Policy};
 use super::prune::{keep_best, pad, prune};
+use super::semantic::{entries, LabelParams, Labelling};
 use super::style::ToneTransform;
 use crate::inference::model::InferenceModel;
 
@@ -61,6 +62,12 @@ pub struct ControlModel {
     pub kept: Vec<Vec<usize>>,
     /// The tones' policies (same successor costs, each tone's `psi`).
     pub tones: Vec<TonePolicy>,
+    /// The library's labels (empty: none).
+    pub labelling: Labelling,
+    /// Per label, the policy while it waits (`u`, `u_cont`: `U^w`, `U_cont^w`).
+    pub label_policies: Vec<Policy>,
+    /// Per exit point, per labelled segment: the semantic entry `(frame, cost)`.
+    pub entries: Vec<Vec<(usize, f64)>>,
     /// Stage timings.
     pub timings: Timings,
 }
@@ -96,6 +103,7 @@ pub fn build(
     lib: &Library,
     params: &ControlParams,
     tones: &[ToneTransform],
+    labels: Option<(&Labelling, &LabelParams)>,
 ) -> ControlModel {
     let t0 = Instant::now();
     let psi = psi(lib, &model.hmm.emit, params.cost.psi_samples);
@@ -120,13 +128,47 @@ pub fn build(
             psi,
         })
         .collect();
+    let (labelling, label_policies, entries) = match labels {
+        Some((lab, lp)) if !lab.is_empty() => {
+            let ent = entries(lib, &sig, &params.cost, lab, lp);
+            let pols: Vec<Policy> = (0..lab.names.len())
+                .map(|w| {
+                    let code = (w + 1) as u8;
+                    let carries: Vec<bool> = lab.label_of.iter().map(|&l| l == code).collect();
+                    let mine: Vec<Vec<(usize, f64)>> = ent
+                        .iter()
+                        .map(|row| {
+                            lab.segments
+                                .iter()
+                                .zip(row)
+                                .filter(|(&c, _)| carries[c])
+                                .map(|(&c, &(_, x))| (c, x))
+                                .collect()
+                        })
+                        .collect();
+                    let problem = LabelProblem {
+                        carries: &carries,
+                        semantic_cost: lp.semantic_cost,
+                        entries: &mine,
+                    };
+                    solve_label(lib, &psi, &p, &params.mdp, &policy, &problem)
+                })
+                .collect();
+            (lab.clone(), pols, ent)
+        }
+        _ => (Labelling::default(), Vec::new(), Vec::new()),
+    };
     let t2 = Instant::now();
     let min = params
         .min_successors
         .unwrap_or(super::prune::MIN_SUCCESSORS);
     let mut front = prune(&policy);
-    for t in &tones {
-        for (all, more) in front.iter_mut().zip(prune(&t.policy)) {
+    let more_fronts: Vec<Vec<Vec<usize>>> = tones.iter().map(|t| prune(&t.policy)).collect();
+    // Labels add no successors: while one waits, the candidates are the shared lists and the
+    // label's entries, so a labelled blob given no label decides exactly as one packed without
+    // labels (the lists, and the quantization of their costs, are the same).
+    for more_front in more_fronts {
+        for (all, more) in front.iter_mut().zip(more_front) {
             all.extend(more);
             all.sort_unstable();
             all.dedup();
@@ -144,6 +186,9 @@ pub fn build(
         pruned,
         kept,
         tones,
+        labelling,
+        label_policies,
+        entries,
         timings: Timings {
             costs: (t1 - t0).as_secs_f64(),
             value_iteration: (t2 - t1).as_secs_f64(),

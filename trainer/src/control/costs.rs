@@ -206,8 +206,15 @@ impl Signatures {
 
     /// Junction distance from frame `f` of `a` to the first frame of `b`.
     pub fn junction(&self, lib: &Library, a: usize, f: usize, b: usize) -> f64 {
-        let (pa, pb) = (lib.pose(a, f), lib.pose(b, 0));
-        let (va, vb) = (lib.velocity(a, f), lib.velocity(b, 0));
+        self.junction_at(lib, a, f, b, 0)
+    }
+
+    /// Junction distance from frame `f` of `a` to frame `g` of `b`: effector pose difference
+    /// over the library's spread of start poses plus half the velocity difference over its
+    /// spread of velocities.
+    pub fn junction_at(&self, lib: &Library, a: usize, f: usize, b: usize, g: usize) -> f64 {
+        let (pa, pb) = (lib.pose(a, f), lib.pose(b, g));
+        let (va, vb) = (lib.velocity(a, f), lib.velocity(b, g));
         let dp: f64 = pa
             .iter()
             .zip(pb)

@@ -292,6 +292,129 @@ pub fn solve(
     }
 }
 
+/// What a waiting semantic label changes in the MDP (docs/method.md "Semantic labels").
+pub struct LabelProblem<'a> {
+    /// Per segment, whether it carries the label.
+    pub carries: &'a [bool],
+    /// Cost of a decision that does not serve the label.
+    pub semantic_cost: f64,
+    /// Per exit point, the semantic entries: `(segment, entry cost)` for each segment carrying
+    /// the label (entered before its stroke).
+    pub entries: &'a [Vec<(usize, f64)>],
+}
+
+/// Value iteration while a label waits: entering a segment that carries it (at its first frame
+/// or by a semantic entry) serves the label, and from then on the `neutral` policy's values
+/// hold; every other choice costs `semantic_cost` more and the label goes on waiting.
+///
+/// ```text
+/// U^w(c, s)      = U(c, s)                                                  c carries w
+///                = w_enter(c) psi_c(s) + gamma sum P^n(c)(s, s') Q^w(first_exit(c), s')  else
+/// U_cont^w(e, s) = U_cont(e, s) if e's segment carries w, else as U_cont with Q^w
+/// Q^w(e, s)      = min( U_cont^w(e, s) + C [e's segment does not carry w],
+///                       min_c S(e, c) + U^w(c, s) + C [c does not carry w],
+///                       min_(c, x) in entries(e)  x + U(c, s) )
+/// ```
+///
+/// The returned policy's `u`/`u_cont` are `U^w`/`U_cont^w` (what the blob stores); its `q` is
+/// `Q^w`.
+pub fn solve_label(
+    lib: &Library,
+    psi: &[Vec<f64>],
+    p: &[Vec<f64>],
+    params: &MdpParams,
+    neutral: &Policy,
+    label: &LabelProblem<'_>,
+) -> Policy {
+    let s = p.len();
+    let Propagation {
+        enter,
+        cont,
+        pw,
+        w_enter,
+        w_cont,
+    } = propagation(lib, p, params);
+    let n_seg = lib.segments.len();
+    let n_exit = lib.exits.len();
+    let c_sem = label.semantic_cost;
+    let mut q = neutral.q.clone();
+    let mut u = neutral.u.clone();
+    let mut u_cont = neutral.u_cont.clone();
+    let mut iterations = 0;
+    let mut residual = f64::INFINITY;
+    while iterations < params.max_iter && residual > params.tol {
+        u = (0..n_seg)
+            .into_par_iter()
+            .map(|c| {
+                if label.carries[c] {
+                    return neutral.u[c].clone();
+                }
+                let fut = propagate(&pw[enter[c]], &q[lib.first_exit[c]]);
+                (0..s)
+                    .map(|k| w_enter[c] * psi[c][k] + params.discount * fut[k])
+                    .collect()
+            })
+            .collect();
+        u_cont = (0..n_exit)
+            .into_par_iter()
+            .map(|e| {
+                let a = lib.exits[e].segment;
+                if label.carries[a] {
+                    return neutral.u_cont[e].clone();
+                }
+                cont[e].map(|m| {
+                    let fut = propagate(&pw[m], &q[e + 1]);
+                    (0..s)
+                        .map(|k| w_cont[e] * psi[a][k] + params.discount * fut[k])
+                        .collect()
+                })
+            })
+            .collect();
+        let new_q: Vec<Vec<f64>> = (0..n_exit)
+            .into_par_iter()
+            .map(|e| {
+                let a = lib.exits[e].segment;
+                let extra = if label.carries[a] { 0.0 } else { c_sem };
+                let mut best: Vec<f64> = match &u_cont[e] {
+                    Some(uc) => uc.iter().map(|v| v + extra).collect(),
+                    None => vec![f64::INFINITY; s],
+                };
+                for (c, uc) in u.iter().enumerate() {
+                    let sc = neutral.succ[e][c] + if label.carries[c] { 0.0 } else { c_sem };
+                    for k in 0..s {
+                        best[k] = best[k].min(sc + uc[k]);
+                    }
+                }
+                for &(c, x) in &label.entries[e] {
+                    for k in 0..s {
+                        best[k] = best[k].min(x + neutral.u[c][k]);
+                    }
+                }
+                best
+            })
+            .collect();
+        residual = new_q
+            .iter()
+            .zip(&q)
+            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+            .fold(0.0, f64::max);
+        q = new_q;
+        iterations += 1;
+    }
+    Policy {
+        states: s,
+        u,
+        u_cont,
+        succ: neutral.succ.clone(),
+        q,
+        discount: params.discount,
+        w_enter,
+        w_cont,
+        iterations,
+        residual,
+    }
+}
+
 impl Policy {
     /// Expected cost of `action` at exit `e` under belief `b`.
     pub fn cost(&self, e: usize, action: Action, b: &[f64]) -> f64 {

@@ -9,7 +9,8 @@
 //! - [`dp`]: the offline dynamic-programming reference;
 //! - [`build`]: model + library to a solved, pruned policy and its regret.
 //! - [`schedule`]: what random selection and the offline DP reference play, frame by frame;
-//! - [`style`]: tone transforms of the kinematic parameters (per-tone value tables).
+//! - [`style`]: tone transforms of the kinematic parameters (per-tone value tables);
+//! - [`semantic`]: semantic labels, strokes and the entries before them.
 
 // Index loops mirror the recursion's subscripts and are kept on purpose.
 #![allow(clippy::needless_range_loop)]
@@ -21,6 +22,7 @@ pub mod library;
 pub mod mdp;
 pub mod prune;
 pub mod schedule;
+pub mod semantic;
 pub mod style;
 
 pub use library::{ExitPoint, LibSegment, Library};

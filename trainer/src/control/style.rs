@@ -28,7 +28,7 @@
 //! `T^-1(y_a)`: a segment that moves like the tone (faster, for an active tone) is mapped back
 //! to where neutral motion lies, where the states' Gaussians expect it, and so fits better. The
 //! played motion therefore becomes *more* like the tone. (Applying `T` to the segments instead
-//! would make it less like it; [`tests`] checks the direction with a planted tone.)
+//! would make it less like it; a test checks the direction with a planted tone.)
 //!
 //! **Energy** ([`ToneTransform::energy`]): a synthetic tone with no data: path length, speed and
 //! acceleration times `f` (duration, curvature and height unchanged), as a shift of the log

@@ -7,7 +7,7 @@
 //! played motion segmented like the corpus, with the geometric mean over its segments of each
 //! kinematic parameter T, D, V, A, C, H (in body units: the space the tones are fitted in), and
 //! every figure's ratio to the first style given (neutral by convention). Like `eval-motion`,
-//! everything runs the packed bytes through the runtime's device loop ([`play_online`]), the
+//! everything runs the packed bytes through the runtime's device loop (`play_online`), the
 //! style set on its controller with `Controller::set_style`.
 
 use gesture_runtime::blob::Blob;

@@ -4,8 +4,8 @@
 //! of a solved control layer, and the encoding of it all with the runtime's writer.
 
 use gesture_runtime::blob::encode::{
-    encode, EncodeError, JointSpec, OwnedInference, OwnedLibrary, OwnedPolicy, OwnedRig,
-    OwnedSkeleton, OwnedStyles, PolicyInput, SegmentSpec,
+    encode, EncodeError, JointSpec, LabelsInput, OwnedInference, OwnedLabels, OwnedLibrary,
+    OwnedPolicy, OwnedRig, OwnedSkeleton, OwnedStyles, PolicyInput, SegmentSpec,
 };
 use gesture_runtime::blob::{ControlSection, FrontEndSection, Payload, EULER_ORDERS};
 use gesture_runtime::prosody::ProsodyConfig;
@@ -13,6 +13,7 @@ use gesture_runtime::rig::ChannelCal;
 
 use super::{PackError, PackOptions};
 use crate::control::build::ControlModel;
+use crate::control::semantic::{LabelParams, Labelling};
 use crate::control::Library;
 use crate::evaluate::metrics::beat_frames;
 use crate::inference::model::InferenceModel;
@@ -52,6 +53,7 @@ pub fn parts(
     lib: &Library,
     rig: &Rig,
     opts: &PackOptions,
+    labelling: Option<&Labelling>,
 ) -> Result<(Parts, usize), PackError> {
     // Channel angles of every frame, take after take.
     let mut frames: Vec<Vec<f32>> = Vec::new();
@@ -82,8 +84,8 @@ pub fn parts(
         .map(|(i, s)| SegmentSpec {
             start: offsets[s.take] + s.start,
             len: s.len(),
-            stroke: None,
-            label: 0,
+            stroke: labelling.and_then(|l| l.stroke[i]),
+            label: labelling.map_or(0, |l| l.label_of[i]),
             // The recorded successor is stored right after (segments of a take are
             // contiguous and in order).
             continues: s.next == Some(i + 1)
@@ -197,11 +199,50 @@ pub fn styles_section(cm: &ControlModel) -> Result<Option<OwnedStyles>, EncodeEr
     OwnedStyles::new(&names, &u, &u_cont).map(Some)
 }
 
-/// The blob's bytes for `parts`, `policy` and `styles`.
+/// The `labels` section of a solved control layer with labels (`None` without).
+pub fn labels_section(
+    cm: &ControlModel,
+    p: &LabelParams,
+) -> Result<Option<OwnedLabels>, EncodeError> {
+    let lab = &cm.labelling;
+    if lab.is_empty() {
+        return Ok(None);
+    }
+    let s = cm.policy.states;
+    let names: Vec<&str> = lab.names.iter().map(String::as_str).collect();
+    let u: Vec<Vec<f64>> = cm
+        .label_policies
+        .iter()
+        .map(|pol| pol.u.iter().flatten().copied().collect())
+        .collect();
+    let u_cont: Vec<Vec<f64>> = cm
+        .label_policies
+        .iter()
+        .map(|pol| {
+            pol.u_cont
+                .iter()
+                .flat_map(|o| o.clone().unwrap_or_else(|| vec![0.0; s]))
+                .collect()
+        })
+        .collect();
+    OwnedLabels::new(&LabelsInput {
+        names: &names,
+        semantic_cost: p.semantic_cost,
+        timeout_ms: p.timeout_ms,
+        segments: &lab.segments,
+        u: &u,
+        u_cont: &u_cont,
+        entries: &cm.entries,
+    })
+    .map(Some)
+}
+
+/// The blob's bytes for `parts`, `policy`, `styles` and `labels`.
 pub fn encode_with(
     parts: &Parts,
     policy: &OwnedPolicy,
     styles: Option<&OwnedStyles>,
+    labels: Option<&OwnedLabels>,
 ) -> Result<Vec<u8>, EncodeError> {
     encode(&Payload {
         front_end: parts.front_end,
@@ -212,6 +253,7 @@ pub fn encode_with(
         rig: parts.rig.section(),
         skeleton: parts.skeleton.as_ref().map(OwnedSkeleton::section),
         styles: styles.map(OwnedStyles::section),
+        labels: labels.map(OwnedLabels::section),
     })
 }
 

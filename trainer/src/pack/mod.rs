@@ -39,6 +39,7 @@ use serde::Serialize;
 
 use crate::control::build::{build, fit_budget, regret, ControlModel, ControlParams};
 use crate::control::library::LibraryError;
+use crate::control::semantic::{LabelParams, LabelSpec, Labelling};
 use crate::control::style::{ToneError, ToneTransform, ENERGY_TONES};
 use crate::control::Library;
 use crate::corpus::discover;
@@ -47,7 +48,7 @@ use crate::motion::fk::Target;
 use crate::motion::{analyze, read_bvh, EffectorSpec, Motion, SegmentParams, Skeleton};
 use crate::output::{write_atomic, OutputError};
 use crate::rig::{Rig, RigError};
-use assemble::{encode_with, parts, policy_section, styles_section};
+use assemble::{encode_with, labels_section, parts, policy_section, styles_section};
 
 /// Variety costs a blob gets by default (see `gesture_runtime::policy`): chosen with
 /// `gesture-train eval-motion` on held-out spans of the ZeroEGGS takes (README, "Motion
@@ -85,6 +86,10 @@ pub struct PackOptions {
     pub no_skeleton: bool,
     /// Tones (none by default).
     pub styles: StyleOptions,
+    /// Semantic labels by library file name (none by default).
+    pub labels: Vec<LabelSpec>,
+    /// How labels are served.
+    pub label_params: LabelParams,
 }
 
 /// Tones to pack (see the module docs).
@@ -111,6 +116,8 @@ impl Default for PackOptions {
             effectors: EffectorSpec::default(),
             no_skeleton: false,
             styles: StyleOptions::default(),
+            labels: Vec::new(),
+            label_params: LabelParams::default(),
         }
     }
 }
@@ -136,6 +143,23 @@ pub struct SectionBytes {
     pub skeleton: usize,
     /// Tones' value tables (1 byte without tones).
     pub styles: usize,
+    /// Semantic labels (1 byte without labels).
+    pub labels: usize,
+}
+
+/// One labelled clip of the pack report.
+#[derive(Clone, Debug, Serialize)]
+pub struct LabelReport {
+    /// Label name.
+    pub label: String,
+    /// The library file.
+    pub clip: String,
+    /// The segment carrying it.
+    pub segment: usize,
+    /// Its stroke frame within the segment.
+    pub stroke_frame: usize,
+    /// The latest semantic entry frame over all exit points.
+    pub max_entry_frame: usize,
 }
 
 /// One tone of the pack report.
@@ -203,6 +227,8 @@ pub struct PackReport {
     pub agreement: f64,
     /// The tones, in the blob's order.
     pub styles: Vec<ToneReport>,
+    /// The labelled clips.
+    pub labels: Vec<LabelReport>,
     /// Decisions simulated for the regret.
     pub regret_decisions: usize,
     /// Rig name.
@@ -268,6 +294,9 @@ pub enum PackError {
     /// A tone's transform could not be fitted.
     #[error(transparent)]
     Tone(#[from] ToneError),
+    /// The labels do not fit the library.
+    #[error("{0}")]
+    Label(String),
     /// The writer refused the content (a packer bug or a dimension beyond the format).
     #[error(transparent)]
     Encode(#[from] EncodeError),
@@ -347,20 +376,32 @@ pub fn pack_model(
     } else {
         None
     };
-    let (parts, frames) = parts(model, &lib, &rig, opts)?;
+    let labelling = if opts.labels.is_empty() {
+        None
+    } else {
+        Some(Labelling::assign(&lib, &opts.labels).map_err(PackError::Label)?)
+    };
+    let (parts, frames) = parts(model, &lib, &rig, opts, labelling.as_ref())?;
     progress.set_message("pack: fitting the tones");
     let tones = tone_transforms(model, &opts.styles, &opts.effectors)?;
     let load_s = start.elapsed().as_secs_f64();
 
     progress.set_message("pack: value iteration and pruning");
-    let mut cm = build(model, &lib, &opts.control, &tones);
+    let mut cm = build(
+        model,
+        &lib,
+        &opts.control,
+        &tones,
+        labelling.as_ref().map(|l| (l, &opts.label_params)),
+    );
     let t_prune = Instant::now();
     let mut k = None;
     if let Some(budget) = opts.budget_bytes {
         let styles = styles_section(&cm)?;
+        let labels = labels_section(&cm, &opts.label_params)?;
         let size = |c: &ControlModel| {
             policy_section(model, &lib, c)
-                .and_then(|p| encode_with(&parts, &p, styles.as_ref()))
+                .and_then(|p| encode_with(&parts, &p, styles.as_ref(), labels.as_ref()))
                 .map_or(usize::MAX, |b| b.len())
         };
         k = fit_budget(model, &mut cm, budget, &size);
@@ -378,7 +419,8 @@ pub fn pack_model(
     let t_write = Instant::now();
     let policy = policy_section(model, &lib, &cm)?;
     let styles = styles_section(&cm)?;
-    let bytes = encode_with(&parts, &policy, styles.as_ref())?;
+    let labels = labels_section(&cm, &opts.label_params)?;
+    let bytes = encode_with(&parts, &policy, styles.as_ref(), labels.as_ref())?;
     // The writer checked the bytes; what is measured below is what the device reads.
     let blob = Blob::parse(&bytes).map_err(EncodeError::Invalid)?;
     let sizes = blob.section_sizes();
@@ -429,6 +471,7 @@ pub fn pack_model(
             rig: sizes.rig,
             skeleton: sizes.skeleton,
             styles: sizes.styles,
+            labels: sizes.labels,
         },
         segments: lib.segments.len(),
         exit_points: lib.exits.len(),
@@ -440,6 +483,19 @@ pub fn pack_model(
         regret: r.regret,
         agreement: r.agreement,
         styles: tone_reports,
+        labels: cm
+            .labelling
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(k, &c)| LabelReport {
+                label: cm.labelling.names[(cm.labelling.label_of[c] - 1) as usize].clone(),
+                clip: cm.labelling.sources[k].clone(),
+                segment: c,
+                stroke_frame: cm.labelling.stroke[c].unwrap_or(0),
+                max_entry_frame: cm.entries.iter().map(|r| r[k].0).max().unwrap_or(0),
+            })
+            .collect(),
         regret_decisions: decisions,
         rig: rig.name.clone(),
         channels: rig.channels.len(),
