@@ -106,6 +106,20 @@ pub enum Command {
         /// blob's labels).
         #[arg(long, value_name = "CSV")]
         labels: Option<PathBuf>,
+        /// Keyword spotting (feature `kws`): lines `phrase<TAB>label[<TAB>threshold]`; each
+        /// key phrase heard brings its label.
+        #[arg(long, value_name = "FILE")]
+        keywords: Option<PathBuf>,
+    },
+    /// Keyword spotting alone (feature `kws`): the key phrases PocketSphinx hears in a WAV
+    /// file, as CSV `time_s,phrase,label` (time: when detected).
+    Keywords {
+        /// Speech (any common WAV; resampled to 16 kHz).
+        #[arg(long, value_name = "WAV")]
+        audio: PathBuf,
+        /// Lines `phrase<TAB>label[<TAB>threshold]`.
+        #[arg(long, value_name = "FILE")]
+        keywords: PathBuf,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
     /// utterance, and `run` on it (a few seconds after the build).
@@ -213,6 +227,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             blender,
             style,
             labels,
+            keywords,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -227,6 +242,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 blender: *blender,
                 style: style.clone(),
                 labels: labels.clone(),
+                keywords: keywords.clone(),
             },
             out,
         ),
@@ -234,6 +250,17 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
         Command::Soak { blob, hours, seed } => crate::soak::run(blob, *hours, *seed, out),
         Command::Metrics { dir, mocap, json } => {
             crate::metrics_cmd::run(dir, mocap.as_ref(), *json, out)
+        }
+        Command::Keywords { audio, keywords } => {
+            let kw = crate::kws::read_keywords(keywords).map_err(RunError::Style)?;
+            let pcm = gesture_trainer::audio::load_wav_at(audio, 16_000).map_err(RunError::from)?;
+            let found = crate::kws::spot(&pcm.samples, 160, &kw).map_err(RunError::Style)?;
+            writeln!(out, "time_s,phrase,label")?;
+            for d in found {
+                let k = &kw[d.keyword];
+                writeln!(out, "{:.3},{},{}", d.time_s, k.phrase, k.label)?;
+            }
+            Ok(())
         }
         Command::Demo { out: dir } => Ok(crate::demo::demo(
             dir,

@@ -231,6 +231,7 @@ pub fn demo(dir: &Path, params: DemoParams, out: &mut impl Write) -> Result<(), 
             blender: false,
             style: Default::default(),
             labels: None,
+            keywords: None,
         };
         line(
             out,

@@ -25,7 +25,11 @@
 //! - [`soak`]: `gesture-sim soak`: hours of hostile audio through a blob's device loop (drift,
 //!   limits, memory).
 //! - [`vmc`]: the played poses to avatar apps over the VMC protocol (OSC over UDP).
-#![forbid(unsafe_code)]
+//! - [`style`]: `--style`, `--energy`, `--style-track`: the tone weights of a run.
+//! - [`labels`]: `--labels`: semantic labels at audio times.
+//! - [`kws`]: `--keywords`: keyword spotting with CMU PocketSphinx (feature `kws`), the only
+//!   `unsafe` code of the crate (its FFI module).
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod bench;
@@ -34,6 +38,7 @@ pub mod demo;
 pub mod error;
 pub mod eval;
 pub mod eval_cmd;
+pub mod kws;
 pub mod labels;
 pub mod live;
 pub mod metrics_cmd;

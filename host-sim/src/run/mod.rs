@@ -77,6 +77,8 @@ pub struct RunConfig {
     pub style: crate::style::StyleFlags,
     /// Semantic labels at audio times (`--labels CSV`; [`crate::labels`]).
     pub labels: Option<PathBuf>,
+    /// Keyword spotting (`--keywords FILE`; [`crate::kws`]).
+    pub keywords: Option<PathBuf>,
 }
 
 /// Why `run` failed.
@@ -353,6 +355,37 @@ pub fn write_all(dir: &Path, files: &[(&'static str, Vec<u8>)]) -> Result<Vec<Pa
     })
 }
 
+/// The keywords of `path` and, per keyword, the index of its label among `label_names`.
+pub fn keyword_labels(
+    path: &Path,
+    label_names: &[&str],
+) -> Result<(Vec<crate::kws::Keyword>, Vec<usize>), RunError> {
+    let kw = crate::kws::read_keywords(path).map_err(RunError::Style)?;
+    let index = kw
+        .iter()
+        .map(|k| {
+            label_names
+                .iter()
+                .position(|n| *n == k.label)
+                .ok_or_else(|| {
+                    RunError::Style(format!(
+                        "{}: keyword `{}` brings the label `{}`, which the blob does not have \
+                         (its labels: {})",
+                        path.display(),
+                        k.phrase,
+                        k.label,
+                        if label_names.is_empty() {
+                            "none".to_string()
+                        } else {
+                            label_names.join(", ")
+                        }
+                    ))
+                })
+        })
+        .collect::<Result<Vec<usize>, RunError>>()?;
+    Ok((kw, index))
+}
+
 /// Runs the command; the summary goes to `out`.
 pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::SimError> {
     let total = Instant::now();
@@ -372,6 +405,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     inputs.extend(cfg.bone_map.as_deref());
     inputs.extend(cfg.style.style_track.as_deref());
     inputs.extend(cfg.labels.as_deref());
+    inputs.extend(cfg.keywords.as_deref());
     gesture_trainer::output::refuse_inputs(&outputs, &inputs).map_err(RunError::from)?;
     let bytes = read_blob(&cfg.blob)?;
     let blob = Blob::parse(&bytes).map_err(|source| RunError::Blob {
@@ -382,9 +416,13 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     let tones: Vec<&str> = blob.tone_names().collect();
     let styles = cfg.style.schedule(&tones).map_err(RunError::Style)?;
     let label_names: Vec<&str> = blob.label_names().collect();
-    let labels = match &cfg.labels {
+    let mut labels = match &cfg.labels {
         Some(p) => crate::labels::read_label_track(p, &label_names).map_err(RunError::Style)?,
         None => Vec::new(),
+    };
+    let keywords = match &cfg.keywords {
+        Some(p) => Some(keyword_labels(p, &label_names)?),
+        None => None,
     };
     let rate = blob.prosody_config().sample_rate_hz;
     let pcm = load_wav_at(&cfg.audio, rate).map_err(RunError::from)?;
@@ -393,6 +431,22 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         None => None,
     };
     let chunk = ((cfg.chunk_ms / 1000.0 * rate as f64).round() as usize).max(1);
+    if let Some((kw, index)) = &keywords {
+        if rate != 16_000 {
+            return Err(RunError::Style(format!(
+                "--keywords: the recognizer listens at 16000 Hz, the blob at {rate} Hz"
+            ))
+            .into());
+        }
+        for d in crate::kws::spot(&pcm.samples, chunk, kw).map_err(RunError::Style)? {
+            labels.push(crate::run::sim::LabelPush {
+                time_s: d.time_s,
+                label: index[d.keyword],
+                source: format!("keyword `{}`", kw[d.keyword].phrase),
+            });
+        }
+        labels.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    }
     let sim = simulate(
         &blob,
         &pcm.samples,
