@@ -388,3 +388,41 @@ fn bad_style_options_are_refused_in_one_line() {
         assert!(!out.exists());
     }
 }
+
+/// `pack`'s label options: every mistake is one line, exit 2, nothing written.
+#[test]
+fn bad_label_options_are_refused_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.blob");
+    let file = dir.path().join("labels.csv");
+    std::fs::write(&file, "pattern,label,stroke_s\n*_bye_*,bye,soon\n").unwrap();
+    let file = file.to_str().unwrap().to_string();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--label", "bye"], "expected NAME=PATTERN"),
+        (vec!["--label", "b y=*"], "cannot name a label"),
+        (vec!["--label", "bye=[*"], "bad pattern"),
+        (
+            vec!["--label-file", &file],
+            "labels.csv:2: `soon` is not a time",
+        ),
+        (vec!["--label-timeout-ms", "5"], "--label-timeout-ms"),
+    ];
+    for (extra, want) in cases {
+        let mut args = vec![
+            "pack",
+            "--model",
+            "/no/model.json",
+            "--library",
+            "/no/library",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra.iter().copied());
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{extra:?}: {err}");
+        assert!(err.contains(want), "{extra:?}: {want:?} not in {err}");
+        assert!(!out.exists());
+    }
+}
