@@ -31,6 +31,11 @@
 //! dearest mix, every value table read at every candidate, so the measured cost is the worst a
 //! style can make it. `check` gives `gesture-sim run` the same `--style`.
 //!
+//! ## Labels
+//!
+//! A blob with semantic labels is given label 0 at the sample times of [`LABELS`], as a
+//! keyword spotter or a button would, so the labelled decisions are checked too.
+//!
 //! `no_std`, no heap: the device and the DMA buffer are on the caller's stack.
 
 use core::convert::Infallible;
@@ -45,6 +50,9 @@ use gesture_runtime::rig::{duty_cycle, PULSE_MAX_US, PULSE_MIN_US};
 
 /// Samples per DMA buffer (16 ms at 16 kHz).
 pub const CHUNK: usize = 256;
+/// Semantic labels given to a blob that has labels: `(sample, label)`, at DMA buffer
+/// boundaries (1.504 s and 4.0 s); `check` gives `gesture-sim run` the same as `--labels`.
+pub const LABELS: [(usize, usize); 2] = [(94 * CHUNK, 0), (250 * CHUNK, 0)];
 /// Sample rate of the embedded audio.
 pub const AUDIO_RATE_HZ: u32 = 16_000;
 /// Servo channels of the board (the puppet rig, `rigs/puppet-8ch.toml`).
@@ -265,8 +273,17 @@ pub fn run(
     let mut failure: Option<RunError> = None;
     // The DMA buffer: samples land here in RAM before the controller sees them.
     let mut dma = [0i16; CHUNK];
-    for bytes in audio.chunks(2 * CHUNK) {
+    let labelled = blob.labels() > 0;
+    for (k, bytes) in audio.chunks(2 * CHUNK).enumerate() {
         let n = bytes.len() / 2;
+        if labelled {
+            for &(at, label) in &LABELS {
+                if at == k * CHUNK {
+                    // A full queue drops the label, as on a board.
+                    let _ = device.controller_mut().push_label(label);
+                }
+            }
+        }
         for (s, b) in dma.iter_mut().zip(bytes.chunks_exact(2)) {
             *s = i16::from_le_bytes([b[0], b[1]]);
         }

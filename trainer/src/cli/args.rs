@@ -102,6 +102,11 @@ pub struct ControlArgs {
     /// cost are added: they give the variety costs something to choose from).
     #[arg(long, default_value_t = crate::control::prune::MIN_SUCCESSORS, value_parser = |s: &str| count(s, 1, 4096))]
     pub min_successors: usize,
+    /// Most successors kept per exit point (the best by expected cost under the state prior;
+    /// the regret it costs is reported): bounds the work of one decision on a board. Default:
+    /// every non-dominated one.
+    #[arg(long, value_parser = |s: &str| count(s, 1, 4096))]
+    pub max_successors: Option<usize>,
 }
 
 impl ControlArgs {
@@ -112,6 +117,7 @@ impl ControlArgs {
         p.cost.interruption_penalty = self.interruption_penalty;
         p.cost.junction_weight = self.junction_weight;
         p.min_successors = Some(self.min_successors);
+        p.max_successors = self.max_successors;
         p
     }
 

@@ -127,7 +127,7 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.entries_total,
         100.0 * r.pruned_fraction,
         r.successors_per_exit
-            .map_or(String::new(), |k| format!(", at most {k} per exit point for the budget")),
+            .map_or(String::new(), |k| format!(", at most {k} per exit point")),
         100.0 * r.regret,
         100.0 * r.agreement,
         r.regret_decisions

@@ -415,6 +415,10 @@ pub fn pack_model(
             k = None;
         }
     }
+    if k.is_none() {
+        let most = cm.pruned.iter().map(Vec::len).max().unwrap_or(0);
+        k = opts.control.max_successors.filter(|&m| m < most);
+    }
     let pruning_extra = t_prune.elapsed().as_secs_f64();
     let t_write = Instant::now();
     let policy = policy_section(model, &lib, &cm)?;
