@@ -292,6 +292,9 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 seconds: *seconds,
                 redraw: io::IsTerminal::is_terminal(&io::stdout()),
                 styles,
+                // Number keys fire the blob's labels (typed on the terminal).
+                keys: (b.labels() > 0 && io::IsTerminal::is_terminal(&io::stdin()))
+                    .then(|| live::read_keys(io::BufReader::new(io::stdin()))),
             };
             live::live_loop_with(
                 &b,

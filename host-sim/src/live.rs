@@ -157,7 +157,7 @@ pub fn belief_bar(b: &[f32]) -> String {
 }
 
 /// Settings of the live loop.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub struct LiveOptions {
     /// Stop after this much audio (s); `None`: until the source ends.
     pub seconds: Option<f64>,
@@ -166,6 +166,29 @@ pub struct LiveOptions {
     /// Style changes (times from the start of listening; `--style`, `--energy`,
     /// `--style-track`), each given to the controller when the audio reaches it.
     pub styles: Vec<crate::style::StyleChange>,
+    /// Label numbers typed while listening (1-based, the blob's order; see [`read_keys`]):
+    /// each asks the controller for that label.
+    pub keys: Option<std::sync::mpsc::Receiver<usize>>,
+}
+
+/// Reads lines from `input` (the terminal) on a thread and sends the label numbers typed (a
+/// number and Enter: `2` asks for the second label); anything else is ignored. The thread
+/// ends with the input.
+pub fn read_keys(
+    input: impl std::io::BufRead + Send + 'static,
+) -> std::sync::mpsc::Receiver<usize> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in input.lines() {
+            let Ok(line) = line else { break };
+            if let Ok(k) = line.trim().parse::<usize>() {
+                if k >= 1 && tx.send(k).is_err() {
+                    break;
+                }
+            }
+        }
+    });
+    rx
 }
 
 /// What a live session did.
@@ -238,8 +261,26 @@ pub fn live_loop_with(
         blob.segments()
     )?;
     let tones: Vec<&str> = blob.tone_names().collect();
+    let label_names: Vec<&str> = blob.label_names().collect();
+    if opts.keys.is_some() && !label_names.is_empty() {
+        let list: Vec<String> = label_names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| format!("{} {n}", k + 1))
+            .collect();
+        writeln!(out, "labels: {} (type a number and Enter)", list.join(", "))?;
+    }
     let mut next_style = 0usize;
     loop {
+        if let Some(keys) = &opts.keys {
+            while let Ok(k) = keys.try_recv() {
+                let msg = match device.controller_mut().push_label(k - 1) {
+                    Ok(()) => format!("asked for label {k}"),
+                    Err(e) => format!("label {k}: {e}"),
+                };
+                writeln!(out, "{:8.2} s  {msg}", fed as f64 / rate as f64)?;
+            }
+        }
         while let Some(c) = opts.styles.get(next_style) {
             if c.time_s * rate as f64 > fed as f64 {
                 break;

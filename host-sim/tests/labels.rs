@@ -11,31 +11,6 @@ use gesture_runtime::blob::Blob;
 use gesture_trainer::control::semantic::LabelSpec;
 use gesture_trainer::pack::{pack, PackOptions};
 
-/// The setup's model and corpus packed with `take_001` labelled `wave` (one clip: one labelled
-/// segment).
-fn labelled_blob() -> std::path::PathBuf {
-    let s = setup();
-    let path = s.root.join("labelled.blob");
-    if !path.exists() {
-        let opts = PackOptions {
-            labels: vec![LabelSpec {
-                name: "wave".into(),
-                pattern: "take_001*".into(),
-                stroke_s: None,
-            }],
-            ..PackOptions::default()
-        };
-        pack(
-            &s.root.join("model.json"),
-            std::slice::from_ref(&s.corpus),
-            &opts,
-            &path,
-        )
-        .unwrap();
-    }
-    path
-}
-
 fn timeline(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("timeline.json")).unwrap()).unwrap()
 }

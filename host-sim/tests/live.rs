@@ -93,6 +93,41 @@ fn live_loop_runs_a_fake_microphone() {
     assert_eq!(err.exit_code(), 2);
 }
 
+/// Number keys typed while listening ask for the blob's labels; a number that is not a label
+/// says so.
+#[test]
+fn typed_numbers_fire_the_blobs_labels() {
+    let s = setup();
+    let bytes = std::fs::read(labelled_blob()).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    tx.send(1).unwrap();
+    tx.send(9).unwrap();
+    drop(tx);
+    let mut src = FakeSource::new(mic_samples(s), 44_100, 441);
+    let opts = LiveOptions {
+        keys: Some(rx),
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    live_loop(&blob, &mut src, opts, &mut out).unwrap();
+    let printed = String::from_utf8(out).unwrap();
+    for want in [
+        "labels: 1 wave (type a number and Enter)",
+        "asked for label 1",
+        "label wave: received",
+        "label wave: answered by segment",
+        "label wave: stroke",
+        "label 9: label 8 is not one of the blob's 1 labels",
+    ] {
+        assert!(printed.contains(want), "{want:?} not in\n{printed}");
+    }
+    // The terminal reader: numbers from 1 up, anything else ignored.
+    let rx = host_sim::live::read_keys(std::io::Cursor::new("2\nhello\n0\n 3 \n"));
+    let got: Vec<usize> = rx.iter().collect();
+    assert_eq!(got, [2, 3]);
+}
+
 #[test]
 fn without_an_audio_device_live_and_devices_fail_in_one_line() {
     let s = setup();

@@ -64,6 +64,7 @@ fn summarizes_a_valid_blob() {
             .to_string(),
         "rig: \"example\", PWM period 20000 us, 1 channels: head".to_string(),
         "styles: none (neutral only)".to_string(),
+        "labels: none".to_string(),
     ] {
         assert!(text.contains(&want), "missing {want:?} in\n{text}");
     }

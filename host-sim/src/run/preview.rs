@@ -3,7 +3,9 @@
 //! **The contact sheet**, top to bottom: a strip of stick figures at evenly spaced times (the
 //! skeleton's forward kinematics, front view: world X to the right, Y up, one scale for the
 //! strip), each with its time; the intensity curve over the whole audio with the syllables
-//! shaded and the figure times as grey lines, "enter" decisions as green ticks along the top;
+//! shaded and the figure times as grey lines, "enter" decisions as green ticks along the top,
+//! semantic labels as magenta ticks along the bottom joined to a square where their stroke
+//! played;
 //! the belief as a heat strip (one row per state, the belief held since the last step; the
 //! colour is `sqrt(p)` on a dark-blue (0) to yellow (1) ramp, so the spread of a belief over
 //! many states still shows); a time axis in seconds.
@@ -47,6 +49,8 @@ pub(super) const RED: u8 = 6;
 const GREEN: u8 = 7;
 const BONE: u8 = 8;
 pub(super) const PANEL: u8 = 9;
+/// Semantic labels: the request and the stroke.
+const LABEL: u8 = 10;
 const RAMP0: u8 = 16;
 const RAMP_N: usize = 64;
 const PALETTE_LEN: usize = 128;
@@ -56,7 +60,7 @@ const KEEP: u8 = 127;
 /// The palette as RGB triples: fixed colours, then a 64-step dark-blue-to-yellow ramp.
 pub(super) fn palette() -> Vec<u8> {
     let mut p = vec![0u8; PALETTE_LEN * 3];
-    let fixed: [[u8; 3]; 10] = [
+    let fixed: [[u8; 3]; 11] = [
         [250, 250, 247],
         [226, 226, 222],
         [150, 150, 150],
@@ -67,6 +71,7 @@ pub(super) fn palette() -> Vec<u8> {
         [20, 150, 60],
         [45, 45, 70],
         [238, 238, 233],
+        [190, 40, 190],
     ];
     for (i, c) in fixed.iter().enumerate() {
         p[3 * i..3 * i + 3].copy_from_slice(c);
@@ -410,6 +415,18 @@ impl<'a> Plot<'a> {
             if d.entered.is_some() {
                 let px = tx(d.time_s);
                 cv.fill(px, y, px + 2, y + (h / 10).max(3), GREEN);
+            }
+        }
+        // Semantic labels: a magenta tick up from the bottom when one is asked for, joined to
+        // a square where its stroke plays.
+        let (bottom, tick) = (y + h - 1, (h / 6).max(4));
+        for l in &self.sim.labels {
+            let px = tx(l.time_s);
+            cv.fill(px, bottom - tick, px + 2, bottom + 1, LABEL);
+            if let Some(st) = l.stroke_s {
+                let sx = tx(st);
+                cv.line((px, bottom - tick), (sx, bottom - tick), LABEL);
+                cv.fill(sx - 2, bottom - tick - 2, sx + 3, bottom - tick + 3, LABEL);
             }
         }
     }

@@ -303,3 +303,28 @@ pub fn shared_data() -> Option<PathBuf> {
         .and_then(|_| e2e_tests::shared_data("run_on_the_shared_recordings", "beat-scott"))
         .map(|_| e2e_tests::shared_data_dir())
 }
+
+/// The setup's model and corpus packed with `take_001` labelled `wave` (one clip: one labelled
+/// segment).
+pub fn labelled_blob() -> std::path::PathBuf {
+    let s = setup();
+    let path = s.root.join("labelled.blob");
+    if !path.exists() {
+        let opts = gesture_trainer::pack::PackOptions {
+            labels: vec![gesture_trainer::control::semantic::LabelSpec {
+                name: "wave".into(),
+                pattern: "take_001*".into(),
+                stroke_s: None,
+            }],
+            ..gesture_trainer::pack::PackOptions::default()
+        };
+        gesture_trainer::pack::pack(
+            &s.root.join("model.json"),
+            std::slice::from_ref(&s.corpus),
+            &opts,
+            &path,
+        )
+        .unwrap();
+    }
+    path
+}

@@ -23,6 +23,10 @@ fuzz_target!(|data: &[u8]| {
         .map(|&b| f32::from(b) / 64.0 - 0.5)
         .collect();
     let _ = ctl.set_style(&weights);
+    // Labels from the bytes too (some unknown, some queued behind others).
+    for &b in data.iter().take(6) {
+        let _ = ctl.push_label(usize::from(b % 4));
+    }
     let samples: Vec<i16> = data
         .chunks(2)
         .cycle()

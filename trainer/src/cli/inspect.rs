@@ -146,6 +146,20 @@ pub fn summary(b: &Blob<'_>) -> String {
             let _ = writeln!(s, "skeleton: none (no BVH output from this blob)");
         }
     }
+    if b.labels() == 0 {
+        let _ = writeln!(s, "labels: none");
+    } else {
+        let names: Vec<&str> = b.label_names().collect();
+        let _ = writeln!(
+            s,
+            "labels: {} ({}) on {} segments; semantic cost {}, timeout {} ms",
+            b.labels(),
+            names.join(", "),
+            b.labelled_count(),
+            b.semantic_cost(),
+            b.label_timeout_ms()
+        );
+    }
     if b.tones() == 0 {
         let _ = writeln!(s, "styles: none (neutral only)");
     } else {
