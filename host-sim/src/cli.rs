@@ -176,6 +176,10 @@ pub enum Command {
         /// The style (tones of the blob); a style track's times count from the start.
         #[command(flatten)]
         style: StyleFlags,
+        /// Keyword spotting on the microphone (feature `kws`): lines
+        /// `phrase<TAB>label[<TAB>threshold]`.
+        #[arg(long, value_name = "FILE")]
+        keywords: Option<PathBuf>,
     },
 }
 
@@ -274,6 +278,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             vmc,
             bone_map,
             style,
+            keywords,
         } => {
             let bytes = run_cmd::read_blob(blob)?;
             let b =
@@ -283,6 +288,24 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 })?;
             let tones: Vec<&str> = b.tone_names().collect();
             let styles = style.schedule(&tones).map_err(RunError::Style)?;
+            let label_names: Vec<&str> = b.label_names().collect();
+            let keywords = match keywords {
+                Some(p) => {
+                    if b.prosody_config().sample_rate_hz != 16_000 {
+                        return Err(RunError::Style(
+                            "--keywords: the recognizer listens at 16000 Hz, the blob does not"
+                                .into(),
+                        )
+                        .into());
+                    }
+                    let (kw, index) = run_cmd::keyword_labels(p, &label_names)?;
+                    Some((
+                        crate::kws::Stream::new(&kw).map_err(RunError::Style)?,
+                        index,
+                    ))
+                }
+                None => None,
+            };
             let mut sender = match vmc {
                 Some(addr) => Some(run_cmd::vmc_sender(&b, addr, bone_map.as_deref())?),
                 None => None,
@@ -295,6 +318,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 // Number keys fire the blob's labels (typed on the terminal).
                 keys: (b.labels() > 0 && io::IsTerminal::is_terminal(&io::stdin()))
                     .then(|| live::read_keys(io::BufReader::new(io::stdin()))),
+                keywords,
             };
             live::live_loop_with(
                 &b,

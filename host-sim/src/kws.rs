@@ -89,31 +89,67 @@ pub const NO_KWS: &str = "--keywords needs keyword spotting: build with the `kws
      (`cargo run --release -p host-sim --features kws -- ...`, after `sudo apt-get install \
      libpocketsphinx-dev pocketsphinx-en-us`)";
 
-/// Spots `keywords` in `samples` (16 kHz mono) fed in chunks of `chunk` samples.
-#[cfg(not(feature = "kws"))]
-pub fn spot(
-    _samples: &[i16],
-    _chunk: usize,
-    _keywords: &[Keyword],
-) -> Result<Vec<Detection>, String> {
-    Err(NO_KWS.into())
+/// A streaming spotter: 16 kHz samples in, the keywords heard out.
+pub struct Stream {
+    #[cfg(feature = "kws")]
+    spotter: ffi::Spotter,
+    keywords: Vec<Keyword>,
+}
+
+impl std::fmt::Debug for Stream {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Stream")
+            .field("keywords", &self.keywords)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Stream {
+    /// A spotter for `keywords` (without the `kws` feature: the one-line [`NO_KWS`]).
+    pub fn new(keywords: &[Keyword]) -> Result<Self, String> {
+        #[cfg(feature = "kws")]
+        {
+            Ok(Self {
+                spotter: ffi::Spotter::new(keywords)?,
+                keywords: keywords.to_vec(),
+            })
+        }
+        #[cfg(not(feature = "kws"))]
+        {
+            let _ = keywords;
+            Err(NO_KWS.into())
+        }
+    }
+
+    /// Feeds 16 kHz samples; the index of the keyword they completed, if any.
+    pub fn push(&mut self, samples: &[i16]) -> Result<Option<usize>, String> {
+        #[cfg(feature = "kws")]
+        {
+            Ok(self
+                .spotter
+                .push(samples)?
+                .and_then(|p| self.keywords.iter().position(|kw| kw.phrase == p)))
+        }
+        #[cfg(not(feature = "kws"))]
+        {
+            let _ = (samples, &self.keywords);
+            Err(NO_KWS.into())
+        }
+    }
 }
 
 /// Spots `keywords` in `samples` (16 kHz mono) fed in chunks of `chunk` samples.
-#[cfg(feature = "kws")]
 pub fn spot(samples: &[i16], chunk: usize, keywords: &[Keyword]) -> Result<Vec<Detection>, String> {
-    let mut s = ffi::Spotter::new(keywords)?;
+    let mut s = Stream::new(keywords)?;
     let mut out = Vec::new();
     let mut fed = 0usize;
     for c in samples.chunks(chunk.max(1)) {
         fed += c.len();
-        if let Some(phrase) = s.push(c)? {
-            if let Some(k) = keywords.iter().position(|kw| kw.phrase == phrase) {
-                out.push(Detection {
-                    time_s: fed as f64 / 16_000.0,
-                    keyword: k,
-                });
-            }
+        if let Some(k) = s.push(c)? {
+            out.push(Detection {
+                time_s: fed as f64 / 16_000.0,
+                keyword: k,
+            });
         }
     }
     Ok(out)

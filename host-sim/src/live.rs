@@ -169,6 +169,9 @@ pub struct LiveOptions {
     /// Label numbers typed while listening (1-based, the blob's order; see [`read_keys`]):
     /// each asks the controller for that label.
     pub keys: Option<std::sync::mpsc::Receiver<usize>>,
+    /// Keyword spotting on the microphone (`--keywords`): the spotter and, per keyword, the
+    /// index of its label.
+    pub keywords: Option<(crate::kws::Stream, Vec<usize>)>,
 }
 
 /// Reads lines from `input` (the terminal) on a thread and sends the label numbers typed (a
@@ -224,7 +227,7 @@ pub type PoseSink<'a> = dyn FnMut(f64, &[f32]) -> Result<(), String> + 'a;
 pub fn live_loop_with(
     blob: &Blob<'_>,
     source: &mut dyn AudioSource,
-    opts: LiveOptions,
+    mut opts: LiveOptions,
     out: &mut dyn Write,
     on_pose: &mut PoseSink<'_>,
 ) -> Result<LiveStats, LiveError> {
@@ -315,6 +318,17 @@ pub fn live_loop_with(
         }
         fed += pcm.len() as u64;
         let now = fed as f64 / rate as f64;
+        if let Some((spotter, labels)) = &mut opts.keywords {
+            if let Some(k) = spotter.push(&pcm).map_err(LiveError::Backend)? {
+                let label = labels[k];
+                let name = label_names.get(label).copied().unwrap_or("?");
+                let msg = match device.controller_mut().push_label(label) {
+                    Ok(()) => format!("keyword heard: label {name}"),
+                    Err(e) => format!("keyword heard: label {name}: {e}"),
+                };
+                writeln!(out, "{now:8.2} s  {msg}")?;
+            }
+        }
         // Null pins cannot fail.
         let _ = device.push(&pcm, &mut |e| {
             let DeviceEvent::Controller(e) = e else {

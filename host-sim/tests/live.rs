@@ -187,3 +187,39 @@ fn demo_runs_end_to_end_into_a_temp_dir() {
     check_outputs(&out.join("character.blob"), &out.join("run-character"));
     check_outputs(&out.join("puppet.blob"), &out.join("run-puppet"));
 }
+
+/// With keyword spotting (feature `kws`) and the shared recordings: BEAT's second monologue
+/// through a fake microphone at 44.1 kHz; "fashion" brings the label `wave`.
+#[cfg(feature = "kws")]
+#[test]
+fn keywords_heard_on_the_microphone_bring_their_labels() {
+    let Some(d) = e2e_tests::shared_data(
+        "keywords_heard_on_the_microphone_bring_their_labels",
+        "beat-scott",
+    ) else {
+        return;
+    };
+    let s = setup();
+    let bytes = std::fs::read(labelled_blob()).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let kw = s.root.join("kw-live.tsv");
+    std::fs::write(&kw, "fashion\twave\n").unwrap();
+    let (words, index) = host_sim::run::keyword_labels(&kw, &["wave"]).unwrap();
+    let pcm = gesture_trainer::audio::load_wav_at(d.join("2_scott_0_2_2.wav"), 44_100).unwrap();
+    let mic: Vec<f32> = pcm.samples[..44_100 * 25]
+        .iter()
+        .map(|&v| v as f32 / 32768.0)
+        .collect();
+    let mut src = FakeSource::new(mic, 44_100, 441 * 4);
+    let opts = LiveOptions {
+        keywords: Some((host_sim::kws::Stream::new(&words).unwrap(), index)),
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    live_loop(&blob, &mut src, opts, &mut out).unwrap();
+    let printed = String::from_utf8(out).unwrap();
+    // Six times in the first 22 s (PocketSphinx's own full decoder).
+    let heard = printed.matches("keyword heard: label wave").count();
+    assert!((5..=8).contains(&heard), "{heard} in\n{printed}");
+    assert!(printed.contains("label wave: stroke"), "{printed}");
+}
