@@ -39,8 +39,16 @@ pub fn summary(b: &Blob<'_>) -> String {
     let _ = writeln!(
         s,
         "sections (bytes): front_end {}, inference {}, policy {}, control {}, library {}, rig {}, \
-         skeleton {}, styles {}",
-        z.front_end, z.inference, z.policy, z.control, z.library, z.rig, z.skeleton, z.styles
+         skeleton {}, styles {}, labels {}",
+        z.front_end,
+        z.inference,
+        z.policy,
+        z.control,
+        z.library,
+        z.rig,
+        z.skeleton,
+        z.styles,
+        z.labels
     );
     let c = b.prosody_config();
     let _ = writeln!(
