@@ -27,7 +27,9 @@
 //! - [`blob`]: the policy blob format (header, CRC-32, postcard payload): the reader, validated
 //!   once at load into a typed error (accessors are infallible afterwards), and, with the
 //!   `encode` feature, the writer and its quantizer.
-//! - [`policy`]: the choice of the next segment at an exit point from the belief.
+//! - [`policy`]: the choice of the next segment at an exit point from the belief, with the
+//!   variety costs, the user's style (tone weights mixing the value tables) and, while a
+//!   semantic label waits, the label's tables and entries before its stroke.
 //! - [`player`]: segment playback as rig poses with a short blend at cuts.
 //! - [`controller`]: samples in, poses out: front-end, belief, decisions and playback on one
 //!   sample clock; built from a validated blob.
