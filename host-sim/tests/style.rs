@@ -5,30 +5,6 @@
 mod common;
 
 use common::*;
-use gesture_trainer::pack::{pack, PackOptions, StyleOptions};
-
-/// The setup's model and corpus packed with the energy knob (`energetic`, `calm`).
-fn styled_blob() -> std::path::PathBuf {
-    let s = setup();
-    let path = s.root.join("styled.blob");
-    if !path.exists() {
-        let opts = PackOptions {
-            styles: StyleOptions {
-                energy: Some(1.5),
-                ..StyleOptions::default()
-            },
-            ..PackOptions::default()
-        };
-        pack(
-            &s.root.join("model.json"),
-            std::slice::from_ref(&s.corpus),
-            &opts,
-            &path,
-        )
-        .unwrap();
-    }
-    path
-}
 
 fn timeline(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("timeline.json")).unwrap()).unwrap()

@@ -260,44 +260,42 @@ impl Style {
         self.tones == 0
     }
 
-    /// `b . U(c)` with the tables mixed by these weights: `d_0 (b . U(c)) + sum_m d_m (b .
-    /// U^m(c))`, exactly `t.u_dot(c, b)` when neutral. Each table is read once per candidate
-    /// (a row of S values), so a mix of M tones costs M + 1 dot products.
+    /// `d_0 neutral() + sum_m d_m tone(m)` over the first `tones` tones, skipping zero weights;
+    /// exactly `neutral()` for the neutral style.
     #[inline]
-    fn u_dot<T: PolicyTables + ?Sized>(&self, t: &T, c: usize, b: &[f32]) -> f32 {
+    fn mix(&self, tones: usize, neutral: impl Fn() -> f32, tone: impl Fn(usize) -> f32) -> f32 {
         if self.is_neutral() {
-            return t.u_dot(c, b);
+            return neutral();
         }
         let mut v = if self.neutral > 0.0 {
-            self.neutral * t.u_dot(c, b)
+            self.neutral * neutral()
         } else {
             0.0
         };
-        for (m, &w) in self.weights().iter().enumerate().take(t.tones()) {
+        for (m, &w) in self.weights().iter().enumerate().take(tones) {
             if w > 0.0 {
-                v += w * t.tone_u_dot(m, c, b);
+                v += w * tone(m);
             }
         }
         v
     }
 
+    /// `b . U(c)` with the tables mixed by these weights: `d_0 (b . U(c)) + sum_m d_m (b .
+    /// U^m(c))`, exactly `t.u_dot(c, b)` when neutral. Each table is read once per candidate
+    /// (a row of S values), so a mix of M tones costs M + 1 dot products.
+    #[inline]
+    fn u_dot<T: PolicyTables + ?Sized>(&self, t: &T, c: usize, b: &[f32]) -> f32 {
+        self.mix(t.tones(), || t.u_dot(c, b), |m| t.tone_u_dot(m, c, b))
+    }
+
     /// `b . U_cont(e)` mixed like [`u_dot`](Self::u_dot).
     #[inline]
     fn u_cont_dot<T: PolicyTables + ?Sized>(&self, t: &T, e: usize, b: &[f32]) -> f32 {
-        if self.is_neutral() {
-            return t.u_cont_dot(e, b);
-        }
-        let mut v = if self.neutral > 0.0 {
-            self.neutral * t.u_cont_dot(e, b)
-        } else {
-            0.0
-        };
-        for (m, &w) in self.weights().iter().enumerate().take(t.tones()) {
-            if w > 0.0 {
-                v += w * t.tone_u_cont_dot(m, e, b);
-            }
-        }
-        v
+        self.mix(
+            t.tones(),
+            || t.u_cont_dot(e, b),
+            |m| t.tone_u_cont_dot(m, e, b),
+        )
     }
 }
 

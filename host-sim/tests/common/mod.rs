@@ -328,3 +328,26 @@ pub fn labelled_blob() -> std::path::PathBuf {
     }
     path
 }
+
+/// The setup's model and corpus packed with the energy knob (`energetic`, `calm`).
+pub fn styled_blob() -> std::path::PathBuf {
+    let s = setup();
+    let path = s.root.join("styled.blob");
+    if !path.exists() {
+        let opts = gesture_trainer::pack::PackOptions {
+            styles: gesture_trainer::pack::StyleOptions {
+                energy: Some(1.5),
+                ..gesture_trainer::pack::StyleOptions::default()
+            },
+            ..gesture_trainer::pack::PackOptions::default()
+        };
+        gesture_trainer::pack::pack(
+            &s.root.join("model.json"),
+            std::slice::from_ref(&s.corpus),
+            &opts,
+            &path,
+        )
+        .unwrap();
+    }
+    path
+}

@@ -208,6 +208,63 @@ mod tests {
         }
     }
 
+    /// A label that costs nothing to wait for and has no segment is the neutral problem: the
+    /// same values.
+    #[test]
+    fn a_free_label_without_segments_is_the_neutral_policy() {
+        let lib = small_library(20.0);
+        let (psi, succ, p) = random_problem(&lib, 3, 6);
+        let params = MdpParams::default();
+        let pol = mdp::solve(&lib, &psi, succ, &p, &params);
+        let carries = vec![false; lib.segments.len()];
+        let entries = vec![Vec::new(); lib.exits.len()];
+        let label = mdp::LabelProblem {
+            carries: &carries,
+            semantic_cost: 0.0,
+            entries: &entries,
+        };
+        let lp = mdp::solve_label(&lib, &psi, &p, &params, &pol, &label);
+        for (a, b) in lp.q.iter().zip(&pol.q) {
+            for (x, y) in a.iter().zip(b) {
+                assert!((x - y).abs() < 1e-6 * (1.0 + y.abs()), "{x} vs {y}");
+            }
+        }
+    }
+
+    /// Waiting is very dear and entering segment `x` at no cost serves the label from any exit
+    /// point: outside `x`, the value of every exit is then exactly `x`'s neutral `U`.
+    #[test]
+    fn a_dear_label_is_served_at_once_through_its_entry() {
+        let lib = small_library(20.0);
+        let (psi, succ, p) = random_problem(&lib, 3, 7);
+        let params = MdpParams::default();
+        let pol = mdp::solve(&lib, &psi, succ, &p, &params);
+        let x = lib.segments.len() / 2;
+        let carries: Vec<bool> = (0..lib.segments.len()).map(|c| c == x).collect();
+        let entries = vec![vec![(x, 0.0)]; lib.exits.len()];
+        let label = mdp::LabelProblem {
+            carries: &carries,
+            semantic_cost: 1e6,
+            entries: &entries,
+        };
+        let lp = mdp::solve_label(&lib, &psi, &p, &params, &pol, &label);
+        for (e, ex) in lib.exits.iter().enumerate() {
+            if ex.segment == x {
+                continue;
+            }
+            for k in 0..3 {
+                let want = pol.u[x][k].min(pol.succ[e][x] + pol.u[x][k]);
+                assert!(
+                    (lp.q[e][k] - want).abs() < 1e-9,
+                    "exit {e}: {} vs {want}",
+                    lp.q[e][k]
+                );
+            }
+        }
+        // The stored table keeps the neutral U for the segment that carries the label.
+        assert_eq!(lp.u[x], pol.u[x]);
+    }
+
     #[test]
     fn offline_dp_is_no_worse_than_following_the_policy() {
         let lib = small_library(20.0);
