@@ -210,10 +210,12 @@ mod ffi {
             let words = std::fs::read_to_string(&dict).map_err(|e| format!("{dict}: {e}"))?;
             for kw in keywords {
                 for w in kw.phrase.split(' ') {
+                    // `word` or one of its variants `word(2)`, ...
+                    let variant = format!("{w}(");
                     let known = words.lines().any(|l| {
                         l.split_whitespace()
                             .next()
-                            .is_some_and(|d| d == w || d.starts_with(&format!("{w}(")))
+                            .is_some_and(|d| d == w || d.starts_with(&variant))
                     });
                     if !known {
                         return Err(format!(

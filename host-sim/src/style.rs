@@ -22,7 +22,9 @@
 
 use std::path::{Path, PathBuf};
 
-use gesture_trainer::control::style::{known_tones, normalized_weights, parse_weights};
+use gesture_trainer::control::style::{
+    known_tones, normalized_weights, parse_weights as parse_spec,
+};
 
 /// The style flags of `run` and `live`.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -70,11 +72,6 @@ pub struct StyleChange {
     pub time_s: f64,
     /// Weight per tone of the blob.
     pub weights: Vec<f32>,
-}
-
-/// The weight vector of `spec` for a blob with `tones` (the trainer's rule, shared).
-pub fn parse_spec(spec: &str, tones: &[&str], what: &str) -> Result<Vec<f32>, String> {
-    parse_weights(spec, tones, what)
 }
 
 /// `weights` with the energy knob `e` added (see the module docs).

@@ -304,20 +304,11 @@ pub fn shared_data() -> Option<PathBuf> {
         .map(|_| e2e_tests::shared_data_dir())
 }
 
-/// The setup's model and corpus packed with `take_001` labelled `wave` (one clip: one labelled
-/// segment).
-pub fn labelled_blob() -> std::path::PathBuf {
+/// The setup's model and corpus packed with `opts` into `name` under the setup's folder, once.
+fn packed_once(name: &str, opts: gesture_trainer::pack::PackOptions) -> PathBuf {
     let s = setup();
-    let path = s.root.join("labelled.blob");
+    let path = s.root.join(name);
     if !path.exists() {
-        let opts = gesture_trainer::pack::PackOptions {
-            labels: vec![gesture_trainer::control::semantic::LabelSpec {
-                name: "wave".into(),
-                pattern: "take_001*".into(),
-                stroke_s: None,
-            }],
-            ..gesture_trainer::pack::PackOptions::default()
-        };
         gesture_trainer::pack::pack(
             &s.root.join("model.json"),
             std::slice::from_ref(&s.corpus),
@@ -329,25 +320,32 @@ pub fn labelled_blob() -> std::path::PathBuf {
     path
 }
 
+/// The setup's model and corpus packed with `take_001` labelled `wave` (one clip: one labelled
+/// segment).
+pub fn labelled_blob() -> PathBuf {
+    packed_once(
+        "labelled.blob",
+        gesture_trainer::pack::PackOptions {
+            labels: vec![gesture_trainer::control::semantic::LabelSpec {
+                name: "wave".into(),
+                pattern: "take_001*".into(),
+                stroke_s: None,
+            }],
+            ..gesture_trainer::pack::PackOptions::default()
+        },
+    )
+}
+
 /// The setup's model and corpus packed with the energy knob (`energetic`, `calm`).
-pub fn styled_blob() -> std::path::PathBuf {
-    let s = setup();
-    let path = s.root.join("styled.blob");
-    if !path.exists() {
-        let opts = gesture_trainer::pack::PackOptions {
+pub fn styled_blob() -> PathBuf {
+    packed_once(
+        "styled.blob",
+        gesture_trainer::pack::PackOptions {
             styles: gesture_trainer::pack::StyleOptions {
                 energy: Some(1.5),
                 ..gesture_trainer::pack::StyleOptions::default()
             },
             ..gesture_trainer::pack::PackOptions::default()
-        };
-        gesture_trainer::pack::pack(
-            &s.root.join("model.json"),
-            std::slice::from_ref(&s.corpus),
-            &opts,
-            &path,
-        )
-        .unwrap();
-    }
-    path
+        },
+    )
 }

@@ -68,6 +68,27 @@ fn fit<T: TryFrom<usize>>(
     T::try_from(value).map_err(|_| EncodeError::TooLarge { what, value, ty })
 }
 
+/// `{index: u16, cost: i16}` records of `rows`, the costs quantized together (symmetric over
+/// their largest finite magnitude): the quantization and the bytes. `what` names the index for
+/// errors.
+fn records<'r>(
+    rows: impl Iterator<Item = &'r (usize, f64)> + Clone,
+    what: &'static str,
+) -> Result<(Quantization, Vec<u8>), EncodeError> {
+    let max = rows
+        .clone()
+        .map(|&(_, c)| c)
+        .filter(|c| c.is_finite())
+        .fold(0.0f64, |m, c| m.max(c.abs()));
+    let q = Quantization::symmetric(max);
+    let mut out = Vec::new();
+    for &(index, cost) in rows {
+        out.extend(fit::<u16>(what, index, "u16")?.to_le_bytes());
+        out.extend(q.code(cost).to_le_bytes());
+    }
+    Ok((q, out))
+}
+
 fn inconsistent<T>(msg: String) -> Result<T, EncodeError> {
     Err(EncodeError::Inconsistent(msg))
 }
@@ -284,23 +305,11 @@ impl OwnedPolicy {
             exits.extend(fit::<u16>("exit segment", seg, "u16")?.to_le_bytes());
             exits.extend(fit::<u16>("exit frame", frame, "u16")?.to_le_bytes());
         }
-        let max = p
-            .successors
-            .iter()
-            .flatten()
-            .map(|&(_, c)| c)
-            .filter(|c| c.is_finite())
-            .fold(0.0f64, |m, c| m.max(c.abs()));
-        let q = Quantization::symmetric(max);
+        let (q, succ) = records(p.successors.iter().flatten(), "successor segment")?;
         let mut succ_offsets = Vec::with_capacity(4 * (p.exits.len() + 1));
-        let mut succ = Vec::new();
         let mut n = 0usize;
         succ_offsets.extend(0u32.to_le_bytes());
         for list in p.successors {
-            for &(seg, cost) in list {
-                succ.extend(fit::<u16>("successor segment", seg, "u16")?.to_le_bytes());
-                succ.extend(q.code(cost).to_le_bytes());
-            }
             n += list.len();
             succ_offsets.extend(fit::<u32>("successor entries", n, "u32")?.to_le_bytes());
         }
@@ -753,19 +762,7 @@ impl OwnedLabels {
         for &c in p.segments {
             segments.extend(fit::<u16>("labelled segment", c, "u16")?.to_le_bytes());
         }
-        let max = p
-            .entries
-            .iter()
-            .flatten()
-            .map(|&(_, c)| c)
-            .filter(|c| c.is_finite())
-            .fold(0.0f64, |m, c| m.max(c.abs()));
-        let q = Quantization::symmetric(max);
-        let mut entries = Vec::with_capacity(4 * p.entries.len() * p.segments.len());
-        for &(frame, cost) in p.entries.iter().flatten() {
-            entries.extend(fit::<u16>("entry frame", frame, "u16")?.to_le_bytes());
-            entries.extend(q.code(cost).to_le_bytes());
-        }
+        let (q, entries) = records(p.entries.iter().flatten(), "entry frame")?;
         let flat_u: Vec<f64> = p.u.iter().flatten().copied().collect();
         let flat_uc: Vec<f64> = p.u_cont.iter().flatten().copied().collect();
         Ok(Self {

@@ -202,6 +202,52 @@ fn propagation(lib: &Library, p: &[Vec<f64>], params: &MdpParams) -> Propagation
     }
 }
 
+impl Propagation {
+    /// `U(c, .)` given the exit values `q`: `w_enter(c) psi_c + gamma P^n(c) q(first_exit(c))`.
+    fn enter_value(
+        &self,
+        lib: &Library,
+        psi: &[Vec<f64>],
+        gamma: f64,
+        q: &[Vec<f64>],
+        c: usize,
+    ) -> Vec<f64> {
+        let fut = propagate(&self.pw[self.enter[c]], &q[lib.first_exit[c]]);
+        psi[c]
+            .iter()
+            .zip(fut)
+            .map(|(p, f)| self.w_enter[c] * p + gamma * f)
+            .collect()
+    }
+
+    /// `U_cont(e, .)` given `q` (`None` at end exits): `w_cont(e) psi_a + gamma P^m(e) q(e + 1)`.
+    fn cont_value(
+        &self,
+        lib: &Library,
+        psi: &[Vec<f64>],
+        gamma: f64,
+        q: &[Vec<f64>],
+        e: usize,
+    ) -> Option<Vec<f64>> {
+        self.cont[e].map(|m| {
+            let fut = propagate(&self.pw[m], &q[e + 1]);
+            psi[lib.exits[e].segment]
+                .iter()
+                .zip(fut)
+                .map(|(p, f)| self.w_cont[e] * p + gamma * f)
+                .collect()
+        })
+    }
+}
+
+/// The largest change between two value tables.
+fn max_change(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+        .fold(0.0, f64::max)
+}
+
 fn propagate(pn: &[Vec<f64>], q: &[f64]) -> Vec<f64> {
     pn.iter()
         .map(|row| row.iter().zip(q).map(|(a, b)| a * b).sum())
@@ -217,13 +263,8 @@ pub fn solve(
     params: &MdpParams,
 ) -> Policy {
     let s = p.len();
-    let Propagation {
-        enter,
-        cont,
-        pw,
-        w_enter,
-        w_cont,
-    } = propagation(lib, p, params);
+    let prop = propagation(lib, p, params);
+    let gamma = params.discount;
     let n_seg = lib.segments.len();
     let n_exit = lib.exits.len();
     let mut q = vec![vec![0.0; s]; n_exit];
@@ -234,24 +275,11 @@ pub fn solve(
     while iterations < params.max_iter && residual > params.tol {
         u = (0..n_seg)
             .into_par_iter()
-            .map(|c| {
-                let fut = propagate(&pw[enter[c]], &q[lib.first_exit[c]]);
-                (0..s)
-                    .map(|k| w_enter[c] * psi[c][k] + params.discount * fut[k])
-                    .collect()
-            })
+            .map(|c| prop.enter_value(lib, psi, gamma, &q, c))
             .collect();
         u_cont = (0..n_exit)
             .into_par_iter()
-            .map(|e| {
-                cont[e].map(|m| {
-                    let fut = propagate(&pw[m], &q[e + 1]);
-                    let a = lib.exits[e].segment;
-                    (0..s)
-                        .map(|k| w_cont[e] * psi[a][k] + params.discount * fut[k])
-                        .collect()
-                })
-            })
+            .map(|e| prop.cont_value(lib, psi, gamma, &q, e))
             .collect();
         let new_q: Vec<Vec<f64>> = (0..n_exit)
             .into_par_iter()
@@ -270,11 +298,7 @@ pub fn solve(
                 best
             })
             .collect();
-        residual = new_q
-            .iter()
-            .zip(&q)
-            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
-            .fold(0.0, f64::max);
+        residual = max_change(&new_q, &q);
         q = new_q;
         iterations += 1;
     }
@@ -285,8 +309,8 @@ pub fn solve(
         succ,
         q,
         discount: params.discount,
-        w_enter,
-        w_cont,
+        w_enter: prop.w_enter,
+        w_cont: prop.w_cont,
         iterations,
         residual,
     }
@@ -327,13 +351,8 @@ pub fn solve_label(
     label: &LabelProblem<'_>,
 ) -> Policy {
     let s = p.len();
-    let Propagation {
-        enter,
-        cont,
-        pw,
-        w_enter,
-        w_cont,
-    } = propagation(lib, p, params);
+    let prop = propagation(lib, p, params);
+    let gamma = params.discount;
     let n_seg = lib.segments.len();
     let n_exit = lib.exits.len();
     let c_sem = label.semantic_cost;
@@ -345,29 +364,16 @@ pub fn solve_label(
     while iterations < params.max_iter && residual > params.tol {
         u = (0..n_seg)
             .into_par_iter()
-            .map(|c| {
-                if label.carries[c] {
-                    return neutral.u[c].clone();
-                }
-                let fut = propagate(&pw[enter[c]], &q[lib.first_exit[c]]);
-                (0..s)
-                    .map(|k| w_enter[c] * psi[c][k] + params.discount * fut[k])
-                    .collect()
+            .map(|c| match label.carries[c] {
+                true => neutral.u[c].clone(),
+                false => prop.enter_value(lib, psi, gamma, &q, c),
             })
             .collect();
         u_cont = (0..n_exit)
             .into_par_iter()
-            .map(|e| {
-                let a = lib.exits[e].segment;
-                if label.carries[a] {
-                    return neutral.u_cont[e].clone();
-                }
-                cont[e].map(|m| {
-                    let fut = propagate(&pw[m], &q[e + 1]);
-                    (0..s)
-                        .map(|k| w_cont[e] * psi[a][k] + params.discount * fut[k])
-                        .collect()
-                })
+            .map(|e| match label.carries[lib.exits[e].segment] {
+                true => neutral.u_cont[e].clone(),
+                false => prop.cont_value(lib, psi, gamma, &q, e),
             })
             .collect();
         let new_q: Vec<Vec<f64>> = (0..n_exit)
@@ -393,11 +399,7 @@ pub fn solve_label(
                 best
             })
             .collect();
-        residual = new_q
-            .iter()
-            .zip(&q)
-            .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
-            .fold(0.0, f64::max);
+        residual = max_change(&new_q, &q);
         q = new_q;
         iterations += 1;
     }
@@ -408,8 +410,8 @@ pub fn solve_label(
         succ: neutral.succ.clone(),
         q,
         discount: params.discount,
-        w_enter,
-        w_cont,
+        w_enter: prop.w_enter,
+        w_cont: prop.w_cont,
         iterations,
         residual,
     }
