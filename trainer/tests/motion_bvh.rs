@@ -593,3 +593,15 @@ fn unwritable_joint_names_are_refused() {
         assert!(e.contains("joint names must be"), "{bad:?}: {e}");
     }
 }
+
+/// A frame count no file could hold is refused at its line (without channels the frame lines
+/// are empty, so nothing else would bound it; the fuzzer found one).
+#[test]
+fn an_absurd_frame_count_is_refused() {
+    let bare = "HIERARCHY\nROOT A\n{\nOFFSET 0 0 0\nCHANNELS 0\nEnd Site\n{\nOFFSET 0 1 0\n}\n}\nMOTION\nFrames: 28888888888888888\nFrame Time: 0.1\n";
+    let e = parse_bvh(bare, "huge.bvh").unwrap_err().to_string();
+    assert!(
+        e.contains("huge.bvh:12") && e.contains("from 0 to 10000000"),
+        "{e}"
+    );
+}

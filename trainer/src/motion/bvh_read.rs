@@ -396,15 +396,20 @@ impl<'a> Parser<'a, '_> {
         let tok = self.next_or("`Frames:`")?;
         let frames_line = tok.line;
         let declared = self.labelled_value(tok, "Frames", "`Frames:`")?;
-        let declared: usize = declared.text.parse().map_err(|_| {
-            self.err(
-                declared.line,
-                BvhErrorKind::Unexpected {
-                    expected: "a frame count (a whole number >= 0)".into(),
-                    found: declared.text.to_string(),
-                },
-            )
-        })?;
+        let declared: usize = declared
+            .text
+            .parse()
+            .ok()
+            .filter(|&n: &usize| n <= MAX_FRAMES)
+            .ok_or_else(|| {
+                self.err(
+                    declared.line,
+                    BvhErrorKind::Unexpected {
+                        expected: format!("a frame count (a whole number from 0 to {MAX_FRAMES})"),
+                        found: declared.text.to_string(),
+                    },
+                )
+            })?;
         // `Frame Time: t`.
         let tok = self.next_or("`Frame Time:`")?;
         if !tok.text.eq_ignore_ascii_case("Frame") {
@@ -643,6 +648,11 @@ impl<'a> Parser<'a, '_> {
         Ok(data)
     }
 }
+
+/// Most frames a BVH may declare: 10 million (over 46 hours at 60 fps). A file whose joints
+/// have no channels has empty frame lines, so its `Frames:` cannot be checked against its text;
+/// without a bound, such a file could make every later pass over the frames run for ever.
+pub const MAX_FRAMES: usize = 10_000_000;
 
 fn not_a_number(tok: &str) -> BvhErrorKind {
     let hint = if tok.contains(',') {
