@@ -79,6 +79,7 @@ fn bandai_tones_restyle_a_zeroeggs_library_on_new_speech() {
         mocap: None,
         span: None,
         random_runs: 1,
+        device_runs: 1,
         pack: PackOptions {
             styles,
             ..PackOptions::default()

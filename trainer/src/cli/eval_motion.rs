@@ -34,6 +34,10 @@ pub struct EvalMotionArgs {
     /// Random runs to average.
     #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub random_runs: u64,
+    /// Runs of each device method (online and its ablations) to average, the speech delayed
+    /// by 0.2 s more each time (the variety figures are of the first run).
+    #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=100))]
+    pub device_runs: u64,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -65,6 +69,7 @@ impl EvalMotionArgs {
             mocap: self.mocap.clone(),
             span: self.span,
             random_runs: self.random_runs,
+            device_runs: self.device_runs,
             pack,
         })
     }

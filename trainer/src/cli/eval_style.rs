@@ -63,6 +63,7 @@ pub fn run(a: &EvalStyleArgs) -> Result<(), CliError> {
         mocap: None,
         span: a.span,
         random_runs: 1,
+        device_runs: 1,
         pack,
     };
     let model = InferenceModel::load(&a.model)?;

@@ -61,6 +61,9 @@ pub struct MotionEval {
     pub span: Option<(f64, f64)>,
     /// Random runs to average.
     pub random_runs: u64,
+    /// Runs of each device method to average (the speech delayed by [`PHASE_STEP_S`]
+    /// more of silence each time; 1: the device as it runs, alone).
+    pub device_runs: u64,
     /// How to pack (costs, device settings, effectors); the rig is the library's full
     /// skeleton.
     pub pack: PackOptions,
@@ -280,6 +283,34 @@ fn mocap_trace(
     Ok((t, sub))
 }
 
+/// The delay between two device runs (s), rounded to whole animation frames.
+pub const PHASE_STEP_S: f64 = 0.2;
+
+/// Device runs a [`MotionEval`] averages by default.
+pub const DEFAULT_DEVICE_RUNS: u64 = 10;
+
+/// The device's motion on `samples` delayed by `delay` frames of silence, measured from where
+/// the speech starts (`frames` ticks), and its decisions.
+fn play_delayed(
+    blob: &Blob<'_>,
+    samples: &[i16],
+    rate: u32,
+    frames: usize,
+    delay: usize,
+    setup: impl FnOnce(&mut BlobController<'_>),
+) -> Result<(Playback, Vec<Made>), EvalError> {
+    if delay == 0 {
+        return play_online(blob, samples, frames, setup);
+    }
+    let lead = (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize;
+    let mut input = vec![0i16; lead];
+    input.extend_from_slice(samples);
+    let (mut p, made) = play_online(blob, &input, frames + delay, setup)?;
+    p.poses.drain(..delay.min(p.poses.len()));
+    p.shown.drain(..delay.min(p.shown.len()));
+    Ok((p, made))
+}
+
 fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
     let n = ms.len().max(1) as f64;
     let avg = |f: fn(&MotionMetrics) -> f64| ms.iter().map(f).sum::<f64>() / n;
@@ -298,6 +329,7 @@ fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
         beats_per_s: avg(|m| m.beats_per_s),
         beat_chance: avg(|m| m.beat_chance),
         beat_lift: avg(|m| m.beat_lift),
+        speech_coupling: avg(|m| m.speech_coupling),
         hellinger: avg_opt(|m| m.hellinger),
         // Variety of one run (averages of counts mean little).
         ..ms.first().copied().unwrap_or_default()
@@ -374,28 +406,45 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     // The device, as packed.
     // Drawn only when stderr is a terminal.
     let progress = crate::progress::spinner("eval-motion: the device and its ablations");
-    let (online, made) = play_online(&blob, &samples, frames, |_| {})?;
-    rows.push(Row {
-        method: "online".into(),
-        metrics: measured(&online)?,
-    });
-    let pure = play_online(&blob, &samples, frames, |c| c.set_variety(Variety::NONE))?.0;
-    rows.push(Row {
-        method: "online_pure".into(),
-        metrics: measured(&pure)?,
-    });
+    // Each device method runs `device_runs` times, the speech delayed by a few more frames
+    // each time: its choices depend on where the animation stands when each syllable comes,
+    // so one run is one draw; the variety figures are of the first (undelayed) run, the
+    // others the mean.
+    let runs = e.device_runs.max(1) as usize;
+    let step = ((PHASE_STEP_S * fps).round() as usize).max(1);
     let prior: Vec<f32> = model.state_prior.iter().map(|&v| v as f32).collect();
-    let held = play_online(&blob, &samples, frames, |c| c.hold_belief(Some(&prior)))?.0;
-    rows.push(Row {
-        method: "online_prior".into(),
-        metrics: measured(&held)?,
-    });
-    let shuffled = shuffle_blocks(&samples, rate, 11);
-    let sh = play_online(&blob, &shuffled, frames, |_| {})?.0;
-    rows.push(Row {
-        method: "online_shuffled".into(),
-        metrics: measured(&sh)?,
-    });
+    let mut made = Vec::new();
+    for (name, k) in [
+        ("online", 0),
+        ("online_pure", 1),
+        ("online_prior", 2),
+        ("online_shuffled", 3),
+    ] {
+        let mut ms = Vec::with_capacity(runs);
+        for run in 0..runs {
+            let delay = run * step;
+            let shuffled;
+            let input = if k == 3 {
+                shuffled = shuffle_blocks(&samples, rate, 11 + run as u64);
+                &shuffled
+            } else {
+                &samples
+            };
+            let (p, m) = play_delayed(&blob, input, rate, frames, delay, |c| match k {
+                1 => c.set_variety(Variety::NONE),
+                2 => c.hold_belief(Some(&prior)),
+                _ => {}
+            })?;
+            if k == 0 && run == 0 {
+                made = m;
+            }
+            ms.push(measured(&p)?);
+        }
+        rows.push(Row {
+            method: name.into(),
+            metrics: mean(&ms),
+        });
+    }
     // References, played by the same player.
     let start = 0;
     progress.set_message("eval-motion: random selection and the offline DP");
@@ -455,4 +504,40 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
         variety_regret: excess / best_total.max(1e-12),
         seconds,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Device runs and random runs are averaged figure by figure (the speech coupling
+    /// included), the largest jump is the largest of any run, and the variety figures are the
+    /// first run's.
+    #[test]
+    fn runs_average_every_continuous_figure_and_keep_the_first_runs_variety() {
+        let a = MotionMetrics {
+            distinct_segments: 7,
+            max_segment_share: 0.25,
+            speech_coupling: 0.2,
+            beat_alignment: 0.8,
+            max_jump_at_cuts: 3.0,
+            hellinger: Some(0.1),
+            ..MotionMetrics::default()
+        };
+        let b = MotionMetrics {
+            distinct_segments: 9,
+            max_segment_share: 0.5,
+            speech_coupling: -0.4,
+            beat_alignment: 0.9,
+            max_jump_at_cuts: 5.0,
+            hellinger: Some(0.3),
+            ..MotionMetrics::default()
+        };
+        let m = mean(&[a, b]);
+        assert!((m.speech_coupling + 0.1).abs() < 1e-12, "{m:?}");
+        assert!((m.beat_alignment - 0.85).abs() < 1e-12);
+        assert!((m.hellinger.unwrap() - 0.2).abs() < 1e-12);
+        assert_eq!(m.max_jump_at_cuts, 5.0);
+        assert_eq!((m.distinct_segments, m.max_segment_share), (7, 0.25));
+    }
 }

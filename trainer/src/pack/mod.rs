@@ -51,13 +51,16 @@ use crate::rig::{Rig, RigError};
 use assemble::{encode_with, labels_section, parts, policy_section, styles_section};
 
 /// Variety costs a blob gets by default (see `gesture_runtime::policy`): chosen with
-/// `gesture-train eval-motion` on held-out spans of the ZeroEGGS takes (README, "Motion
-/// quality").
+/// `gesture-train eval-motion` on tuning speech (067's 50 s twice and the six CMU Arctic
+/// sentences, 119 s) with the default models and libraries of both ZeroEGGS takes, never on
+/// the speech the README reports (docs/method.md, "Variety"). A usage window of a minute
+/// (bounded by the 32 remembered entries) spreads the motion over the library in the
+/// proportions the capture has; a shorter one let a few segments come back every half minute.
 pub const DEFAULT_VARIETY: Variety = Variety {
     recency_cost: 1.0,
     recency_ms: 8000,
-    usage_cost: 4.0,
-    usage_ms: 30000,
+    usage_cost: 12.0,
+    usage_ms: 45000,
 };
 
 /// Inertialization time at cuts a blob gets by default (ms).
