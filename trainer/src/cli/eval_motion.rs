@@ -104,5 +104,19 @@ pub fn run(a: &EvalMotionArgs) -> Result<(), CliError> {
     for line in motion_table(&rows) {
         outln!("{line}")?;
     }
+    outln!("runs averaged, and their spread (standard deviation) where there are several:")?;
+    for r in &ev.rows {
+        match &r.spread {
+            Some(s) => outln!(
+                "  {:<16} {:>3} runs   coupling +-{:.3}   beat align +-{:.3}   Hellinger {}",
+                r.method,
+                r.runs,
+                s.speech_coupling,
+                s.beat_alignment,
+                s.hellinger.map_or("-".into(), |h| format!("+-{h:.3}"))
+            )?,
+            None => outln!("  {:<16} {:>3} run", r.method, r.runs)?,
+        }
+    }
     Ok(())
 }

@@ -74,9 +74,55 @@ pub struct MotionEval {
 pub struct Row {
     /// Method name.
     pub method: String,
-    /// Its figures.
+    /// Its figures (means over its runs; the variety figures are the first run's).
     #[serde(flatten)]
     pub metrics: MotionMetrics,
+    /// Runs averaged.
+    pub runs: usize,
+    /// Run-to-run standard deviation of the timing and distribution figures (`None` for one
+    /// run): how far apart two methods must be for a difference to mean something.
+    pub spread: Option<Spread>,
+}
+
+/// Sample standard deviations over a method's runs.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct Spread {
+    /// Of [`MotionMetrics::speech_coupling`].
+    pub speech_coupling: f64,
+    /// Of [`MotionMetrics::beat_alignment`].
+    pub beat_alignment: f64,
+    /// Of [`MotionMetrics::hellinger`].
+    pub hellinger: Option<f64>,
+}
+
+impl Row {
+    /// The row of `method` from its runs' figures (see [`mean`]).
+    fn of_runs(method: &str, runs: &[MotionMetrics]) -> Self {
+        Self {
+            method: method.into(),
+            metrics: mean(runs),
+            runs: runs.len(),
+            spread: spread(runs),
+        }
+    }
+}
+
+/// Sample standard deviation of `f` over `runs` (`None` with fewer than two runs).
+fn sd(runs: &[MotionMetrics], f: impl Fn(&MotionMetrics) -> Option<f64>) -> Option<f64> {
+    let v: Vec<f64> = runs.iter().map(f).collect::<Option<_>>()?;
+    if v.len() < 2 {
+        return None;
+    }
+    let m = v.iter().sum::<f64>() / v.len() as f64;
+    Some((v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt())
+}
+
+fn spread(runs: &[MotionMetrics]) -> Option<Spread> {
+    Some(Spread {
+        speech_coupling: sd(runs, |m| Some(m.speech_coupling))?,
+        beat_alignment: sd(runs, |m| Some(m.beat_alignment))?,
+        hellinger: sd(runs, |m| m.hellinger),
+    })
 }
 
 /// An evaluation's result.
@@ -440,10 +486,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
             }
             ms.push(measured(&p)?);
         }
-        rows.push(Row {
-            method: name.into(),
-            metrics: mean(&ms),
-        });
+        rows.push(Row::of_runs(name, &ms));
     }
     // References, played by the same player.
     let start = 0;
@@ -456,10 +499,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
             ))
         })
         .collect::<Result<_, _>>()?;
-    rows.push(Row {
-        method: "random".into(),
-        metrics: mean(&random),
-    });
+    rows.push(Row::of_runs("random", &random));
     if !offline.is_empty() {
         let prior64 = model.state_prior.clone();
         let post = |t: usize| {
@@ -470,16 +510,16 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
             }
         };
         let plan = play_dp(lib, &cm.policy, &cm.psi, frames, start, &post);
-        rows.push(Row {
-            method: "offline_dp".into(),
-            metrics: measured(&play_schedule(&blob, &plan))?,
-        });
+        rows.push(Row::of_runs(
+            "offline_dp",
+            &[measured(&play_schedule(&blob, &plan))?],
+        ));
     }
     if let Some((t, _)) = &reference {
-        rows.push(Row {
-            method: "mocap".into(),
-            metrics: measure(t, &speech, None, Some((&t.hands, t.fps))),
-        });
+        rows.push(Row::of_runs(
+            "mocap",
+            &[measure(t, &speech, None, Some((&t.hands, t.fps)))],
+        ));
     }
     // What variety costs against the pure policy.
     let (mut excess, mut best_total) = (0.0, 0.0);
@@ -539,5 +579,12 @@ mod tests {
         assert!((m.hellinger.unwrap() - 0.2).abs() < 1e-12);
         assert_eq!(m.max_jump_at_cuts, 5.0);
         assert_eq!((m.distinct_segments, m.max_segment_share), (7, 0.25));
+        // Sample standard deviations: two values d apart have sd d / sqrt(2).
+        let s = spread(&[a, b]).unwrap();
+        let r2 = std::f64::consts::SQRT_2;
+        assert!((s.speech_coupling - 0.6 / r2).abs() < 1e-12, "{s:?}");
+        assert!((s.beat_alignment - 0.1 / r2).abs() < 1e-12);
+        assert!((s.hellinger.unwrap() - 0.2 / r2).abs() < 1e-12);
+        assert_eq!(spread(&[a]), None);
     }
 }
