@@ -549,6 +549,52 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::corpus::{load_corpus, LoadOptions};
+    use crate::inference::train::{fit, sequences, FitConfig};
+    use crate::synth::{write_corpus, SynthParams};
+
+    /// A delayed device run is the undelayed run of the longer input with the lead cut off:
+    /// on silence (nothing for the controller to hear) delaying by `d` frames shows, at every
+    /// tick, what a run `d` frames longer shows `d` ticks later; and it always has `frames`
+    /// ticks.
+    #[test]
+    fn a_delayed_run_is_the_longer_run_without_its_lead() {
+        let dir = tempfile::tempdir().unwrap();
+        let params = SynthParams {
+            minutes: 0.5,
+            seed: 5,
+            take_seconds: 30.0,
+        };
+        write_corpus(&params, dir.path(), |_, _| {}).unwrap();
+        let c = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
+        let (seqs, segs) = sequences(&c, None);
+        let cfg = FitConfig {
+            states: Some(2),
+            clusters: Some(2),
+            restarts: 1,
+            l2: Some(1e-2),
+            ..FitConfig::default()
+        };
+        let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
+        let packed =
+            pack_model(&model, &[dir.path().to_path_buf()], &PackOptions::default()).unwrap();
+        let blob = Blob::parse(&packed.bytes).unwrap();
+        let rate = model.sample_rate_hz;
+        let fps = blob.fps() as f64;
+        let frames = (3.0 * fps) as usize;
+        let silence = vec![0i16; 3 * rate as usize];
+        let d = 7;
+        let (delayed, _) = play_delayed(&blob, &silence, rate, frames, d, |_| {}).unwrap();
+        assert_eq!(delayed.poses.len(), frames);
+        let lead = (d as f64 * rate as f64 / fps).round() as usize;
+        let longer = vec![0i16; lead + silence.len()];
+        let (whole, _) = play_online(&blob, &longer, frames + d, |_| {}).unwrap();
+        assert_eq!(delayed.poses[..], whole.poses[d..]);
+        assert_eq!(delayed.shown[..], whole.shown[d..]);
+        // No delay: the plain run.
+        let (plain, _) = play_delayed(&blob, &silence, rate, frames, 0, |_| {}).unwrap();
+        assert_eq!(plain.poses[..], whole.poses[..frames]);
+    }
 
     /// Device runs and random runs are averaged figure by figure (the speech coupling
     /// included), the largest jump is the largest of any run, and the variety figures are the
