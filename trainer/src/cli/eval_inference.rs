@@ -2,7 +2,7 @@
 //! the online beliefs of the CRF, Brand's remapped HMM and the state prior on `--test` for each
 //! window (the logic is `inference::eval::evaluate`; this file parses and prints). The model
 //! selection curves go to stderr. With `--json`, stdout is exactly one JSON object
-//! `{"rows":[{"window":W,"crf":X,"hmm":Y,"prior":Z,"gain":G,"l2":L,"lag_penalty":P}, ...],
+//! `{"rows":[{"window":W,"crf":X,"hmm":Y,"prior":Z,"gain":G,"gain_se":E,"l2":L,"lag_penalty":P}, ...],
 //! "states":S,"clusters":K,"train_steps":N,"test_steps":M}` (plus `"ari":[train,test]` on a
 //! synthetic corpus); progress and extras go to stderr.
 //!
@@ -129,23 +129,25 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     }
     outln!("mean log-likelihood per test step of the true kinematic parameters")?;
     outln!(
-        "{:>6} {:>10} {:>10} {:>10} {:>10} {:>8} {:>6}",
+        "{:>6} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>6}",
         "window",
         "crf",
         "hmm",
         "prior",
         "gain",
+        "+-se",
         "l2",
         "lag"
     )?;
     for w in &r.rows {
         outln!(
-            "{:>6} {:>10.3} {:>10.3} {:>10.3} {:>+10.3} {:>8} {:>6}",
+            "{:>6} {:>10.3} {:>10.3} {:>10.3} {:>+10.3} {:>7.3} {:>8} {:>6}",
             w.window,
             w.crf,
             w.hmm,
             w.prior,
             w.gain,
+            w.gain_se,
             w.l2,
             w.lag_penalty
         )?;

@@ -45,6 +45,10 @@ pub struct Row {
     pub prior: f64,
     /// `crf - prior`: what the CRF's belief knows beyond the prior (nats per step).
     pub gain: f64,
+    /// Standard error of `gain`: the standard deviation of the per-step differences over the
+    /// square root of the test steps (steps are correlated in time, so this is a lower bound
+    /// on the uncertainty).
+    pub gain_se: f64,
     /// CRF L2 strength per training step used for this window.
     pub l2: f64,
     /// CRF lag penalty used for this window.
@@ -115,11 +119,13 @@ pub fn evaluate(
         log,
     )?;
     let y_test = normalized(test, &base.normalization);
-    let prior = mean_score(&base, &y_test, &prior_beliefs(&base, test));
+    let prior_steps = step_scores(&base, &y_test, &prior_beliefs(&base, test));
+    let prior = mean(&prior_steps);
     let mut rows = Vec::new();
     for (&w, &(l2, lag)) in windows.iter().zip(&choice.regularization) {
         let crf = fit_crf(&base, w, l2, lag, &mut report, log)?;
-        let crf_score = mean_score(&base, &y_test, &crf_beliefs(&base, &crf, test));
+        let crf_steps = step_scores(&base, &y_test, &crf_beliefs(&base, &crf, test));
+        let crf_score = mean(&crf_steps);
         let brand = RemappedHmm::fit(&base, train_seqs, w);
         let hb: Vec<Vec<Vec<f64>>> = test.iter().map(|s| brand.beliefs(&base, s)).collect();
         rows.push(Row {
@@ -128,6 +134,7 @@ pub fn evaluate(
             hmm: mean_score(&base, &y_test, &hb),
             prior,
             gain: crf_score - prior,
+            gain_se: standard_error(&crf_steps, &prior_steps),
             l2,
             lag_penalty: lag,
         });
@@ -177,8 +184,13 @@ pub fn planted_ari(
 
 /// Mean per-step score of `y` (normalized) under beliefs `b` and the HMM state Gaussians.
 pub fn mean_score(base: &FitBase, y: &[Seq], beliefs: &[Vec<Vec<f64>>]) -> f64 {
-    let mut total = 0.0;
-    let mut n = 0usize;
+    mean(&step_scores(base, y, beliefs))
+}
+
+/// The score of every step of `y` (normalized) under beliefs `b` and the HMM state
+/// Gaussians: `log sum_i b_t(i) N(y_t; mu_i, Sigma_i)`.
+pub fn step_scores(base: &FitBase, y: &[Seq], beliefs: &[Vec<Vec<f64>>]) -> Vec<f64> {
+    let mut out = Vec::new();
     for (ys, bs) in y.iter().zip(beliefs) {
         for (yt, bt) in ys.iter().zip(bs) {
             let terms: Vec<f64> = base
@@ -188,11 +200,25 @@ pub fn mean_score(base: &FitBase, y: &[Seq], beliefs: &[Vec<Vec<f64>>]) -> f64 {
                 .zip(bt)
                 .map(|(g, &b)| b.max(1e-300).ln() + g.log_pdf(yt))
                 .collect();
-            total += log_sum_exp(&terms);
-            n += 1;
+            out.push(log_sum_exp(&terms));
         }
     }
-    total / n.max(1) as f64
+    out
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+/// Standard error of the mean of `a[t] - b[t]` (0 with fewer than two steps).
+pub fn standard_error(a: &[f64], b: &[f64]) -> f64 {
+    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+    if d.len() < 2 {
+        return 0.0;
+    }
+    let m = mean(&d);
+    let var = d.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (d.len() - 1) as f64;
+    (var / d.len() as f64).sqrt()
 }
 
 /// CRF beliefs for every test sequence.
@@ -324,6 +350,14 @@ pub fn adjusted_rand_index(a: &[usize], b: &[usize]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn standard_error_known_values() {
+        // Differences 1, 2, 3, 4: sample sd sqrt(5/3), over sqrt(4).
+        let se = standard_error(&[2.0, 4.0, 6.0, 8.0], &[1.0, 2.0, 3.0, 4.0]);
+        assert!((se - (5.0f64 / 3.0).sqrt() / 2.0).abs() < 1e-12, "{se}");
+        assert_eq!(standard_error(&[1.0], &[0.0]), 0.0);
+    }
 
     #[test]
     fn ari_known_values() {
