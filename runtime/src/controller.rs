@@ -258,6 +258,8 @@ impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
         me.label_timeout_ms = blob.label_timeout_ms();
         let blend = me.ms_ticks(blob.blend_ms());
         me.player.set_blend_ticks(blend);
+        me.player
+            .set_speed_cap(crate::player::library_speed_cap(blob));
         Ok(me)
     }
 }

@@ -38,6 +38,59 @@ pub const MAX_CHANNELS: usize = crate::rig::MAX_CHANNELS;
 /// Decay of a critically damped spring over the blend: `a * blend_ticks` (1 % left).
 const SETTLE: f32 = 6.64;
 
+/// The longest a cut's blend is stretched to keep the offset within the speed cap, as a
+/// multiple of the set blend time.
+pub const MAX_BLEND_STRETCH: u32 = 3;
+
+/// Bins of the histogram behind [`library_speed_cap`].
+const SPEED_BINS: usize = 128;
+
+/// The quantile of the library's per-frame channel changes that caps a blend's speed.
+const SPEED_QUANTILE: f32 = 0.99;
+
+/// The speed cap of a blend (degrees per tick): the 99th percentile of the library's own
+/// per-frame channel changes (every channel, every pair of consecutive frames inside a
+/// segment; non-finite values skipped), to within 1/128 of the largest change; 0 for a
+/// library that does not move. Two passes over the frames, fixed memory.
+pub fn library_speed_cap<L: LibraryFrames + ?Sized>(lib: &L) -> f32 {
+    let n = lib.channels().min(MAX_CHANNELS);
+    let each = |visit: &mut dyn FnMut(f32)| {
+        for c in 0..lib.segment_count() {
+            for f in 1..lib.segment_len(c) {
+                for ch in 0..n {
+                    let d = lib.value(c, f, ch) - lib.value(c, f - 1, ch);
+                    if d.is_finite() {
+                        visit(if d < 0.0 { -d } else { d });
+                    }
+                }
+            }
+        }
+    };
+    let mut top = 0.0f32;
+    let mut count = 0u32;
+    each(&mut |d| {
+        top = top.max(d);
+        count = count.saturating_add(1);
+    });
+    if top <= 0.0 || !top.is_finite() || count == 0 {
+        return 0.0;
+    }
+    let mut bins = [0u32; SPEED_BINS];
+    each(&mut |d| {
+        let k = ((d / top) * SPEED_BINS as f32) as usize;
+        bins[k.min(SPEED_BINS - 1)] += 1;
+    });
+    let want = (SPEED_QUANTILE * count as f32) as u32;
+    let mut seen = 0u32;
+    for (k, &b) in bins.iter().enumerate() {
+        seen = seen.saturating_add(b);
+        if seen >= want {
+            return top * (k + 1) as f32 / SPEED_BINS as f32;
+        }
+    }
+    top
+}
+
 /// The library's frames as the player needs them. Built only from validated data: indices
 /// passed in are always in range.
 pub trait LibraryFrames {
@@ -87,9 +140,13 @@ pub struct Player {
     off: [f32; MAX_CHANNELS],
     /// Offset velocity at the cut, per tick.
     vel: [f32; MAX_CHANNELS],
-    /// Ticks since the cut (blending while below `blend_ticks`).
+    /// Ticks since the cut (blending while below `cut_ticks`).
     since: u32,
     blend_ticks: u32,
+    /// This cut's blend time: `blend_ticks`, stretched for a large offset.
+    cut_ticks: u32,
+    /// Fastest the offset may move (degrees per tick at its start; 0: no cap).
+    speed_cap: f32,
     blending: bool,
 }
 
@@ -107,6 +164,8 @@ impl Player {
             vel: [0.0; MAX_CHANNELS],
             since: 0,
             blend_ticks: 0,
+            cut_ticks: 0,
+            speed_cap: 0.0,
             blending: false,
         }
     }
@@ -114,6 +173,18 @@ impl Player {
     /// Cuts blend over `ticks` animation ticks (0: hard cuts).
     pub fn set_blend_ticks(&mut self, ticks: u32) {
         self.blend_ticks = ticks;
+    }
+
+    /// Caps how fast a blend moves the pose: a cut whose offset (the largest over channels,
+    /// in degrees; a rotation group's angle) would decay faster than `deg_per_tick` at its
+    /// fastest gets a longer blend, up to [`MAX_BLEND_STRETCH`] times the set time (0 or a
+    /// non-finite value: no cap). The controller sets [`library_speed_cap`].
+    pub fn set_speed_cap(&mut self, deg_per_tick: f32) {
+        self.speed_cap = if deg_per_tick.is_finite() && deg_per_tick > 0.0 {
+            deg_per_tick
+        } else {
+            0.0
+        };
     }
 
     /// Current segment.
@@ -153,6 +224,7 @@ impl Player {
         self.segment = c;
         self.frame = f;
         self.since = 0;
+        self.cut_ticks = self.blend_ticks;
         self.blending = self.blend_ticks > 0 && self.outputs > 0;
         if !self.blending {
             return;
@@ -175,6 +247,10 @@ impl Player {
             self.off[ch] = if x0.is_finite() { x0 } else { 0.0 };
             self.vel[ch] = if v0.is_finite() { v0 } else { 0.0 };
         }
+        // The largest offset (degrees), for the speed cap: scalar channels as they are, a
+        // rotation group as its angle.
+        let mut grouped = [0u8; MAX_CHANNELS / 8];
+        let mut largest = 0.0f32;
         for g in 0..lib.group_count() {
             let (first, order) = lib.group(g);
             if first.saturating_add(3) > n {
@@ -208,6 +284,25 @@ impl Player {
                 let v0 = w_s[k] - w_t[k];
                 self.off[first + k] = if x0[k].is_finite() { x0[k] } else { 0.0 };
                 self.vel[first + k] = if v0.is_finite() { v0 } else { 0.0 };
+                grouped[(first + k) / 8] |= 1 << ((first + k) % 8);
+            }
+            let (a, b, c) = (self.off[first], self.off[first + 1], self.off[first + 2]);
+            largest =
+                largest.max(libm::sqrtf(a * a + b * b + c * c) * (180.0 / core::f32::consts::PI));
+        }
+        if self.speed_cap > 0.0 {
+            for ch in 0..n {
+                if grouped[ch / 8] & (1 << (ch % 8)) == 0 {
+                    largest = largest.max(self.off[ch].abs());
+                }
+            }
+            // The spring x0 (1 + a t) e^(-a t) moves fastest at t = 1/a, by a x0 / e per
+            // tick: keep that within the cap.
+            let need = SETTLE * largest / (core::f32::consts::E * self.speed_cap);
+            let most = self.blend_ticks.saturating_mul(MAX_BLEND_STRETCH);
+            if need.is_finite() && need > self.blend_ticks as f32 {
+                self.cut_ticks =
+                    (libm::ceilf(need.min(most as f32)) as u32).clamp(self.blend_ticks, most);
             }
         }
     }
@@ -248,11 +343,11 @@ impl Player {
         for (ch, o) in out.iter_mut().enumerate().take(n) {
             *o = self.target(lib, c, f, ch);
         }
-        if self.blending && self.since >= self.blend_ticks {
+        if self.blending && self.since >= self.cut_ticks {
             self.blending = false;
         }
         if self.blending {
-            let a = SETTLE / self.blend_ticks as f32;
+            let a = SETTLE / self.cut_ticks.max(1) as f32;
             // Tick 1 is the first frame of the new segment (the offset is from tick 0).
             let t = (self.since + 1) as f32;
             let decay = libm::expf(-a * t);
@@ -379,6 +474,96 @@ mod tests {
             p.tick(lib, &mut out);
         }
         out
+    }
+
+    /// One channel, `segs` segments of `len` frames, values from `f(segment, frame)`.
+    struct FnLib {
+        segs: usize,
+        len: usize,
+        f: fn(usize, usize) -> f32,
+    }
+
+    impl LibraryFrames for FnLib {
+        fn channels(&self) -> usize {
+            1
+        }
+        fn fps(&self) -> f32 {
+            30.0
+        }
+        fn segment_count(&self) -> usize {
+            self.segs
+        }
+        fn segment_len(&self, _: usize) -> usize {
+            self.len
+        }
+        fn value(&self, c: usize, f: usize, _: usize) -> f32 {
+            (self.f)(c, f)
+        }
+    }
+
+    #[test]
+    fn the_speed_cap_is_the_99th_percentile_of_the_frame_steps() {
+        // 198 steps of 1 degree and 2 of 50: the 99th percentile is 1, found to within a
+        // bin (50 / 128) above it.
+        let lib = FnLib {
+            segs: 1,
+            len: 201,
+            f: |_, f| {
+                if f <= 198 {
+                    f as f32
+                } else {
+                    198.0 + 50.0 * (f - 198) as f32
+                }
+            },
+        };
+        let cap = library_speed_cap(&lib);
+        assert!((1.0..=1.0 + 50.0 / 128.0).contains(&cap), "{cap}");
+        // A library that does not move has no cap.
+        let still = FnLib {
+            segs: 2,
+            len: 10,
+            f: |_, _| 3.0,
+        };
+        assert_eq!(library_speed_cap(&still), 0.0);
+    }
+
+    #[test]
+    fn a_large_offset_blends_no_faster_than_the_cap() {
+        // A cut from 0 to 100 degrees: blended over 9 ticks the spring moves up to
+        // a x0 / e = (6.64 / 9) 100 / e = 27 degrees per tick; capped at 10, the blend takes
+        // ceil(6.64 * 100 / (e * 10)) = 25 ticks and no step exceeds 10.
+        let lib = FnLib {
+            segs: 2,
+            len: 40,
+            f: |c, _| 100.0 * c as f32,
+        };
+        let largest_step = |cap: f32| {
+            let mut p = Player::new();
+            p.set_blend_ticks(9);
+            p.set_speed_cap(cap);
+            let mut out = [0.0; MAX_CHANNELS];
+            for _ in 0..3 {
+                p.tick(&lib, &mut out);
+            }
+            p.enter(&lib, 1);
+            let (mut prev, mut most, mut ticks) = (out[0], 0.0f32, 0);
+            while out[0] != 100.0 && ticks < 100 {
+                p.tick(&lib, &mut out);
+                most = most.max((out[0] - prev).abs());
+                prev = out[0];
+                ticks += 1;
+            }
+            (most, ticks)
+        };
+        let (free, free_ticks) = largest_step(0.0);
+        // (The frames come back exactly on the tick after the blend.)
+        assert!(free > 25.0 && free_ticks == 9 + 1, "{free} {free_ticks}");
+        let (capped, capped_ticks) = largest_step(10.0);
+        assert!(capped <= 10.0, "{capped}");
+        assert_eq!(capped_ticks, 25 + 1);
+        // A cap the blend cannot meet within MAX_BLEND_STRETCH times the blend stops there.
+        let (_, stretched) = largest_step(1.0);
+        assert_eq!(stretched, 9 * MAX_BLEND_STRETCH + 1);
     }
 
     #[test]

@@ -249,6 +249,7 @@ pub fn play_schedule(blob: &Blob<'_>, schedule: &[Played]) -> Playback {
     let mut player = Player::new();
     let blend = (blob.blend_ms() as f64 * blob.fps() as f64 / 1000.0).ceil() as u32;
     player.set_blend_ticks(blend);
+    player.set_speed_cap(gesture_runtime::player::library_speed_cap(blob));
     let mut out = Playback::default();
     let mut pose = [0.0f32; MAX_CHANNELS];
     let n = blob.channels();
