@@ -10,6 +10,12 @@
 //! Unlike a crossfade, the new motion starts at once (its stroke is not delayed), and unlike a
 //! linear blend, no frame jumps.
 //!
+//! **Speed cap.** Closing a large offset in the blend time is itself a fast swing. With
+//! [`Player::set_speed_cap`] (the controller sets [`library_speed_cap`], the library's own
+//! 99th percentile per-frame channel change), a cut whose spring would move faster than the
+//! cap at its fastest (`a x0 / e` per tick for the largest offset `x0`) blends longer, up to
+//! [`MAX_BLEND_STRETCH`] times the set time.
+//!
 //! Channels are blended as what they are:
 //! - a single angle (a servo, a twist, one Euler angle of a puppet): offset in degrees, linear
 //!   (a servo's 170 and -170 degrees are far apart, not neighbours);
