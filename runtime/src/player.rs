@@ -307,8 +307,8 @@ impl Player {
             let need = SETTLE * largest / (core::f32::consts::E * self.speed_cap);
             let most = self.blend_ticks.saturating_mul(MAX_BLEND_STRETCH);
             if need.is_finite() && need > self.blend_ticks as f32 {
-                self.cut_ticks =
-                    (libm::ceilf(need.min(most as f32)) as u32).clamp(self.blend_ticks, most);
+                // Between blend_ticks (need is above it) and most.
+                self.cut_ticks = libm::ceilf(need.min(most as f32)) as u32;
             }
         }
     }

@@ -330,6 +330,26 @@ fn mocap_trace(
     Ok((t, sub))
 }
 
+/// The device methods: the controller as packed and its ablations (see the module docs).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Ablation {
+    None,
+    Pure,
+    Prior,
+    Shuffled,
+}
+
+impl Ablation {
+    fn name(self) -> &'static str {
+        match self {
+            Self::None => "online",
+            Self::Pure => "online_pure",
+            Self::Prior => "online_prior",
+            Self::Shuffled => "online_shuffled",
+        }
+    }
+}
+
 /// The delay between two device runs (s), rounded to whole animation frames.
 pub const PHASE_STEP_S: f64 = 0.2;
 
@@ -346,9 +366,6 @@ fn play_delayed(
     delay: usize,
     setup: impl FnOnce(&mut BlobController<'_>),
 ) -> Result<(Playback, Vec<Made>), EvalError> {
-    if delay == 0 {
-        return play_online(blob, samples, frames, setup);
-    }
     let lead = (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize;
     let mut input = vec![0i16; lead];
     input.extend_from_slice(samples);
@@ -461,33 +478,32 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     let step = ((PHASE_STEP_S * fps).round() as usize).max(1);
     let prior: Vec<f32> = model.state_prior.iter().map(|&v| v as f32).collect();
     let mut made = Vec::new();
-    for (name, k) in [
-        ("online", 0),
-        ("online_pure", 1),
-        ("online_prior", 2),
-        ("online_shuffled", 3),
+    for method in [
+        Ablation::None,
+        Ablation::Pure,
+        Ablation::Prior,
+        Ablation::Shuffled,
     ] {
         let mut ms = Vec::with_capacity(runs);
         for run in 0..runs {
-            let delay = run * step;
             let shuffled;
-            let input = if k == 3 {
+            let input = if method == Ablation::Shuffled {
                 shuffled = shuffle_blocks(&samples, rate, 11 + run as u64);
                 &shuffled
             } else {
                 &samples
             };
-            let (p, m) = play_delayed(&blob, input, rate, frames, delay, |c| match k {
-                1 => c.set_variety(Variety::NONE),
-                2 => c.hold_belief(Some(&prior)),
-                _ => {}
+            let (p, m) = play_delayed(&blob, input, rate, frames, run * step, |c| match method {
+                Ablation::Pure => c.set_variety(Variety::NONE),
+                Ablation::Prior => c.hold_belief(Some(&prior)),
+                Ablation::None | Ablation::Shuffled => {}
             })?;
-            if k == 0 && run == 0 {
+            if method == Ablation::None && run == 0 {
                 made = m;
             }
             ms.push(measured(&p)?);
         }
-        rows.push(Row::of_runs(name, &ms));
+        rows.push(Row::of_runs(method.name(), &ms));
     }
     // References, played by the same player.
     let start = 0;
