@@ -7,7 +7,9 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use gesture_trainer::evaluate::metrics::{measure, Entry, MotionMetrics, Speech, Trace};
+use gesture_trainer::evaluate::metrics::{
+    measure, speed_histogram, Entry, MotionMetrics, Speech, Trace,
+};
 use gesture_trainer::evaluate::table::motion_table;
 use gesture_trainer::motion::{read_bvh, EffectorSpec};
 use serde::Deserialize;
@@ -89,7 +91,7 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
             let m = read_bvh(p).map_err(|e| SimError::Metrics(e.to_string()))?;
             let t = Trace::from_motion(&m, &EffectorSpec::default(), Vec::new())
                 .map_err(|e| bad(p, e))?;
-            Some((t.hands, t.fps))
+            Some(speed_histogram(&t.hands, t.fps))
         }
         None => None,
     };
@@ -97,7 +99,7 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
         &trace,
         &speech,
         Some(tl.segments),
-        reference.as_ref().map(|(h, f)| (h.as_slice(), *f)),
+        reference.as_deref(),
     ))
 }
 

@@ -41,7 +41,9 @@
 //!   take correlates -0.19 and +0.01 with the 10 ms intensity): people move their hands
 //!   faster while they speak louder;
 //! - **the hands' speed distribution** against a reference (GENEA's Hellinger distance of
-//!   hand-speed histograms, 10 units/s bins up to 250 and one overflow bin).
+//!   hand-speed histograms, 10 units/s bins up to 250 and one overflow bin): the capture of
+//!   the same speech when there is one; `eval-motion` otherwise builds one from the
+//!   library's capture in speech like this ([`crate::evaluate::motion`]).
 //!
 //! Pure functions of their inputs; no panics on empty or short traces (figures of an empty
 //! trace are 0).
@@ -300,11 +302,26 @@ fn speeds(pos: &[Vec<Vec3>], fps: f64) -> Vec<Vec<f64>> {
 
 /// Normalized hand-speed histogram (see the module docs).
 pub fn speed_histogram(hands: &[Vec<Vec3>], fps: f64) -> Vec<f64> {
+    speed_histogram_where(hands, fps, |_| true)
+}
+
+/// The hand-speed histogram of the frame steps (frame `i` to `i + 1`, at time `(i + 1) /
+/// fps`) whose time `keep` accepts, normalized (all zero when none is).
+pub fn speed_histogram_where(
+    hands: &[Vec<Vec3>],
+    fps: f64,
+    keep: impl Fn(f64) -> bool,
+) -> Vec<f64> {
     let mut h = vec![0.0; 26];
     let mut n = 0.0;
-    for v in speeds(hands, fps).iter().flatten() {
-        h[((v / 10.0) as usize).min(25)] += 1.0;
-        n += 1.0;
+    for (i, step) in speeds(hands, fps).iter().enumerate() {
+        if !keep((i + 1) as f64 / fps) {
+            continue;
+        }
+        for v in step {
+            h[((v / 10.0) as usize).min(25)] += 1.0;
+            n += 1.0;
+        }
     }
     h.iter_mut().for_each(|x| *x /= f64::max(n, 1.0));
     h
@@ -544,13 +561,13 @@ pub fn still_share(rotations: &[Vec<f64>], fps: f64) -> f64 {
 }
 
 /// Every figure of `t` (see the module docs): `speech` what it was played to (times in seconds
-/// from the trace's start), `library` the library's segment count, `reference` the hand
-/// positions of the capture (and their frame rate) to compare hand speeds with.
+/// from the trace's start), `library` the library's segment count, `reference` the
+/// hand-speed histogram ([`speed_histogram`]) to compare the hands' speeds with.
 pub fn measure(
     t: &Trace,
     speech: &Speech,
     library: Option<usize>,
-    reference: Option<(&[Vec<Vec3>], f64)>,
+    reference: Option<&[f64]>,
 ) -> MotionMetrics {
     let n = t.frames();
     let fps = t.fps.max(1e-9);
@@ -634,8 +651,7 @@ pub fn measure(
     m.beats_per_s = beats.len() as f64 / seconds.max(1e-9);
     m.beat_chance = beat_chance(onsets, &beats, seconds, BEAT_SIGMA_S);
     m.beat_lift = m.beat_alignment - m.beat_chance;
-    m.hellinger =
-        reference.map(|(r, r_fps)| hellinger(&speed_histogram(h, fps), &speed_histogram(r, r_fps)));
+    m.hellinger = reference.map(|r| hellinger(&speed_histogram(h, fps), r));
     m
 }
 
@@ -797,6 +813,31 @@ mod tests {
     }
 
     #[test]
+    fn a_histogram_of_chosen_frames_counts_only_them() {
+        // Still for 1 s, then 55 units/s for 1 s, at 30 fps.
+        let fps = 30.0;
+        let hands: Vec<Vec<Vec3>> = (0..61)
+            .map(|f| {
+                let x = if f <= 30 {
+                    0.0
+                } else {
+                    55.0 * (f - 30) as f64 / fps
+                };
+                vec![[x, 0.0, 0.0]]
+            })
+            .collect();
+        let late = speed_histogram_where(&hands, fps, |t| t > 1.0 + 1e-9);
+        assert!((late[5] - 1.0).abs() < 1e-9, "{late:?}");
+        let early = speed_histogram_where(&hands, fps, |t| t <= 1.0 + 1e-9);
+        assert!((early[0] - 1.0).abs() < 1e-9, "{early:?}");
+        let all = speed_histogram(&hands, fps);
+        assert!((all[0] - 0.5).abs() < 1e-9 && (all[5] - 0.5).abs() < 1e-9);
+        assert!(speed_histogram_where(&hands, fps, |_| false)
+            .iter()
+            .all(|&v| v == 0.0));
+    }
+
+    #[test]
     fn small_wiggles_are_not_strokes() {
         // A speed signal (units/s along x) with two big peaks 1 s apart and a 2 Hz ripple
         // whose peaks stand 0.4 above their troughs (less than half the median speed, about 1).
@@ -804,7 +845,8 @@ mod tests {
         let speed = |f: usize| -> f64 {
             let t = f as f64 / fps;
             let bump = |c: f64, h: f64| h * (-(t - c) * (t - c) / (2.0 * 0.05 * 0.05)).exp();
-            1.0 + bump(1.0, 4.0) + bump(2.0, 4.0)
+            1.0 + bump(1.0, 4.0)
+                + bump(2.0, 4.0)
                 + 0.2 * (2.0 * std::f64::consts::PI * 2.0 * t).sin()
         };
         let mut x = 0.0;

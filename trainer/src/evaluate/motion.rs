@@ -21,6 +21,14 @@
 //! put back on the library's skeleton ([`PoseSkeleton`]) and measured there, so the figures
 //! describe what a viewer of the character sees.
 //!
+//! **The hand-speed reference.** With `--mocap`, the capture of the speech itself. Without
+//! one (another speaker's speech), [`speech_matched_reference`]: the library's capture in
+//! its syllables and in its pauses, weighed as the new speech has them. The library's whole
+//! capture, the reference before, rewarded playing the library's own mix of rest and motion
+//! whatever the speech: the 9-joint ZeroEGGS take rests through long pauses (a third of its
+//! frames below 10 cm/s) that a monologue does not have, so uniformly random choices were
+//! closest to it and a controller that gestures while the speaker talks was furthest.
+//!
 //! **Regret of variety.** For every decision of the online run, the float, unpruned policy's
 //! expected cost of the choice made is compared with the best choice under the same belief
 //! (variety costs excluded): `variety_regret` is the excess over the best, as a fraction.
@@ -33,13 +41,16 @@ use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::inference::StepNormalizer;
 use gesture_runtime::player::{LibraryFrames, Player, MAX_CHANNELS};
 use gesture_runtime::policy::{Choice, Variety};
-use gesture_runtime::prosody::ProsodyConfig;
+use gesture_runtime::prosody::{ProsodyConfig, Step, StepKind};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
-use super::metrics::{entries_from_frames, measure, Entry, MotionMetrics, Speech, Trace};
+use super::metrics::{
+    entries_from_frames, measure, speed_histogram, speed_histogram_where, Entry, MotionMetrics,
+    Speech, Trace,
+};
 use crate::control::mdp::Action;
 use crate::control::schedule::{play_dp, play_random, Played};
 use crate::inference::model::InferenceModel;
@@ -400,6 +411,91 @@ fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
     }
 }
 
+/// `f` of the normalized `spoken` histogram and `1 - f` of the normalized `paused` one;
+/// `None` when either is empty.
+pub fn mix_by_speech(spoken: &[f64], paused: &[f64], f: f64) -> Option<Vec<f64>> {
+    let (zs, zp) = (spoken.iter().sum::<f64>(), paused.iter().sum::<f64>());
+    (zs > 0.0 && zp > 0.0).then(|| {
+        spoken
+            .iter()
+            .zip(paused)
+            .map(|(s, p)| f * s / zs + (1.0 - f) * p / zp)
+            .collect()
+    })
+}
+
+/// Share of `seconds` that the syllables of `steps` cover.
+fn syllable_share(steps: &[Step], seconds: f64) -> f64 {
+    let spoken: f64 = steps
+        .iter()
+        .filter(|s| s.kind == StepKind::Syllable)
+        .map(|s| s.end_s().min(seconds) - s.start_s().min(seconds))
+        .sum();
+    (spoken / seconds.max(1e-9)).clamp(0.0, 1.0)
+}
+
+/// What the library's character does in speech like the new speech, as the reference of the
+/// hands' speeds when the speech has no capture of its own: the library's capture split
+/// into the frames spoken in syllables and those in pauses (its own speech, the WAV beside
+/// each BVH, through the blob's front-end), the two histograms weighted by the share of the
+/// new speech in syllables. People gesture while they speak and rest while they pause, so a
+/// take with long pauses is not what the same person does through a monologue. When a take
+/// has no speech beside it (a gesture library of clips), the library's whole capture.
+pub fn speech_matched_reference(
+    lib: &crate::control::library::Library,
+    config: &ProsodyConfig,
+    rate: u32,
+    steps: &[Step],
+    seconds: f64,
+) -> Vec<f64> {
+    let hands_of = |t: &crate::control::library::LibTake| -> Vec<Vec<[f64; 3]>> {
+        let pos = &t.analysis.positions;
+        (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect()
+    };
+    let whole = || {
+        let mut hands = Vec::new();
+        for t in &lib.takes {
+            hands.extend(hands_of(t));
+        }
+        speed_histogram(&hands, lib.fps)
+    };
+    let mut spoken = vec![0.0; 26];
+    let mut paused = vec![0.0; 26];
+    for t in &lib.takes {
+        let wav = t.source.with_extension("wav");
+        let Ok(pcm) = crate::audio::load_wav_at(&wav, rate) else {
+            return whole();
+        };
+        let Ok((_, own)) = crate::features::prosody_of(&pcm.samples, config) else {
+            return whole();
+        };
+        // Syllable spans in time order (steps tile the speech in order).
+        let spans: Vec<(f64, f64)> = own
+            .iter()
+            .filter(|s| s.kind == StepKind::Syllable)
+            .map(|s| (s.start_s(), s.end_s()))
+            .collect();
+        let in_syllable = |time: f64| {
+            let k = spans.partition_point(|&(a, _)| a <= time);
+            k > 0 && time < spans[k - 1].1
+        };
+        let hands = hands_of(t);
+        let fps = t.motion.fps();
+        // Each take weighs by its frames in syllables and in pauses.
+        let steps_of = hands.len().saturating_sub(1);
+        let n_spoken = (0..steps_of)
+            .filter(|&i| in_syllable((i + 1) as f64 / fps))
+            .count() as f64;
+        let hs = speed_histogram_where(&hands, fps, in_syllable);
+        let hp = speed_histogram_where(&hands, fps, |time| !in_syllable(time));
+        for k in 0..26 {
+            spoken[k] += n_spoken * hs[k];
+            paused[k] += (steps_of as f64 - n_spoken) * hp[k];
+        }
+    }
+    mix_by_speech(&spoken, &paused, syllable_share(steps, seconds)).unwrap_or_else(whole)
+}
+
 /// Evaluates `model` on `e` (see the module docs).
 pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluation, EvalError> {
     if e.audio.is_empty() {
@@ -445,25 +541,15 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
         None => None,
     };
     // Hand speeds are compared with the speech's own capture when there is one, else with the
-    // library's capture (the character's own range of motion).
-    let ref_hands = match &reference {
-        Some((t, _)) => (t.hands.clone(), t.fps),
-        None => {
-            let mut hands = Vec::new();
-            for take in &lib.takes {
-                let pos = &take.analysis.positions;
-                hands.extend((0..pos.frames()).map(|f| pos.frame(f).to_vec()));
-            }
-            (hands, fps)
-        }
+    // library's capture in speech like this (see `speech_matched_reference`).
+    let ref_hist: Vec<f64> = match &reference {
+        Some((t, _)) => speed_histogram(&t.hands, t.fps),
+        None => speech_matched_reference(lib, &config, rate, &steps, seconds),
     };
-    let ref_hands = Some(ref_hands);
     let segments = lib.segments.len();
     let measured = |p: &Playback| -> Result<MotionMetrics, EvalError> {
         let t = trace_of(&blob, &skeleton, p, &pack)?;
-        // Hand speeds are compared at the reference's own rate.
-        let r = ref_hands.as_ref().map(|(h, f)| (h.as_slice(), *f));
-        Ok(measure(&t, &speech, Some(segments), r))
+        Ok(measure(&t, &speech, Some(segments), Some(&ref_hist)))
     };
     let mut rows = Vec::new();
 
@@ -535,7 +621,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     if let Some((t, _)) = &reference {
         rows.push(Row::of_runs(
             "mocap",
-            &[measure(t, &speech, None, Some((&t.hands, t.fps)))],
+            &[measure(t, &speech, None, Some(&ref_hist))],
         ));
     }
     // What variety costs against the pure policy.
@@ -569,6 +655,38 @@ mod tests {
     use crate::corpus::{load_corpus, LoadOptions};
     use crate::inference::train::{fit, sequences, FitConfig};
     use crate::synth::{write_corpus, SynthParams};
+    use gesture_runtime::prosody::Step;
+
+    #[test]
+    fn the_speech_matched_reference_weighs_speech_and_pauses_as_the_new_speech_has_them() {
+        // Hands still in the capture's pauses (bin 0) and at 55 units/s in its syllables
+        // (bin 5), in any proportion: new speech spoken 70 % of its time gets 0.7 in bin 5.
+        let mut spoken = vec![0.0; 26];
+        let mut paused = vec![0.0; 26];
+        spoken[5] = 300.0;
+        paused[0] = 900.0;
+        let r = mix_by_speech(&spoken, &paused, 0.7).unwrap();
+        assert!((r[5] - 0.7).abs() < 1e-12 && (r[0] - 0.3).abs() < 1e-12);
+        assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+        // A capture without pauses (or without speech) cannot be split.
+        assert_eq!(mix_by_speech(&spoken, &[0.0; 26], 0.7), None);
+        // Syllables of 0.5 s and 1 s and a pause step of 0.5 s in 4 s of speech: 3/8 spoken.
+        let step = |kind, a: u32, b: u32| Step {
+            kind,
+            start_frame: a,
+            end_frame: b,
+            f0_hz: None,
+            intensity_db: 60.0,
+        };
+        let steps = [
+            step(StepKind::Syllable, 0, 50),
+            step(StepKind::Pause, 50, 100),
+            step(StepKind::Syllable, 100, 200),
+        ];
+        assert!((syllable_share(&steps, 4.0) - 0.375).abs() < 1e-12);
+        // Past the end of the audio nothing counts: 0.5 s + 0.5 s of 1.5 s.
+        assert!((syllable_share(&steps, 1.5) - 2.0 / 3.0).abs() < 1e-12);
+    }
 
     /// A delayed device run is the undelayed run of the longer input with the lead cut off:
     /// on silence (nothing for the controller to hear) delaying by `d` frames shows, at every
