@@ -174,7 +174,7 @@ pub fn build(
             all.dedup();
         }
     }
-    let pruned = pad(&policy, &front, model.state_prior.len(), min);
+    let pruned = pad(&policy, &front, min);
     let kept = match params.max_successors {
         Some(k) => keep_best(&policy, &pruned, &model.state_prior, k),
         None => pruned.clone(),

@@ -69,10 +69,10 @@ pub fn prune(policy: &Policy) -> Vec<Vec<usize>> {
 pub const MIN_SUCCESSORS: usize = 12;
 
 /// `kept` with every exit padded to at least `min` successors (fewer if there are fewer
-/// segments): the `states` states and the transition take turns, each adding its next best
+/// segments): the policy's states and the transition take turns, each adding its next best
 /// successor not yet in the list (a state: by the cost in that state alone; the transition:
 /// by `S(e, c)` alone, the segments that follow this exit best). Sorted by segment index.
-pub fn pad(policy: &Policy, kept: &[Vec<usize>], states: usize, min: usize) -> Vec<Vec<usize>> {
+pub fn pad(policy: &Policy, kept: &[Vec<usize>], min: usize) -> Vec<Vec<usize>> {
     kept.iter()
         .enumerate()
         .map(|(e, list)| {
@@ -91,9 +91,9 @@ pub fn pad(policy: &Policy, kept: &[Vec<usize>], states: usize, min: usize) -> V
                 v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                 v.into_iter().map(|(_, c)| c).collect()
             };
-            let mut ranked: Vec<Vec<usize>> = (0..states)
+            let mut ranked: Vec<Vec<usize>> = (0..policy.states)
                 .map(|s| {
-                    let corner: Vec<f64> = (0..states).map(|i| f64::from(i == s)).collect();
+                    let corner: Vec<f64> = (0..policy.states).map(|i| f64::from(i == s)).collect();
                     rank(&|c| policy.cost(e, super::mdp::Action::Enter(c), &corner))
                 })
                 .collect();
@@ -183,14 +183,14 @@ mod tests {
         let front = prune(&p);
         assert_eq!(front, vec![vec![0, 1]]);
         // Turns: state 0 adds 4, state 1 adds 2, the transition adds 7.
-        assert_eq!(pad(&p, &front, 2, 5), vec![vec![0, 1, 2, 4, 7]]);
+        assert_eq!(pad(&p, &front, 5), vec![vec![0, 1, 2, 4, 7]]);
         // Next turn: state 0 adds 5, state 1 adds 3, the transition adds 6.
-        assert_eq!(pad(&p, &front, 2, 8), vec![vec![0, 1, 2, 3, 4, 5, 6, 7]]);
+        assert_eq!(pad(&p, &front, 8), vec![vec![0, 1, 2, 3, 4, 5, 6, 7]]);
         // Never more than there are segments, and a long enough list is left alone.
-        assert_eq!(pad(&p, &front, 2, 20)[0].len(), 8);
-        assert_eq!(pad(&p, &front, 2, 2), front);
+        assert_eq!(pad(&p, &front, 20)[0].len(), 8);
+        assert_eq!(pad(&p, &front, 2), front);
         // The added candidates are dominated: the pure choice is the same for any belief.
-        let padded = pad(&p, &front, 2, 8);
+        let padded = pad(&p, &front, 8);
         for k in 0..=10 {
             let b = [k as f64 / 10.0, 1.0 - k as f64 / 10.0];
             assert_eq!(

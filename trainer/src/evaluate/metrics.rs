@@ -433,7 +433,7 @@ pub fn chance_shifts() -> impl Iterator<Item = f64> {
 /// speeds on either side before a higher speed, looked for within [`STROKE_WINDOW_S`]) is at
 /// least [`STROKE_PROMINENCE`] times the trace's median speed, and that are not within
 /// [`STROKE_GAP_S`] of a higher stroke (SciPy's `find_peaks` with `prominence`, `wlen` and
-/// `distance`; written out here, it is a dozen lines).
+/// `distance`, written out: no crate here does it for `f64` slices).
 pub fn stroke_frames(hands: &[Vec<Vec3>], fps: f64) -> Vec<usize> {
     let sp = smoothed_hand_speed(hands, fps);
     let n = sp.len();
@@ -471,10 +471,9 @@ pub fn stroke_frames(hands: &[Vec<Vec3>], fps: f64) -> Vec<usize> {
     };
     peaks.retain(|&p| sp[p] - side_min(p, -1).max(side_min(p, 1)) >= min_prom.max(1e-12));
     // Highest first; drop those near a kept one.
-    let mut order = peaks.clone();
-    order.sort_by(|&a, &b| sp[b].total_cmp(&sp[a]).then(a.cmp(&b)));
+    peaks.sort_by(|&a, &b| sp[b].total_cmp(&sp[a]).then(a.cmp(&b)));
     let mut kept: Vec<usize> = Vec::new();
-    for p in order {
+    for p in peaks {
         if kept.iter().all(|&q| p.abs_diff(q) >= gap.max(1)) {
             kept.push(p);
         }

@@ -482,15 +482,15 @@ pub fn speech_matched_reference(
         let hands = hands_of(t);
         let fps = t.motion.fps();
         // Each take weighs by its frames in syllables and in pauses.
-        let steps_of = hands.len().saturating_sub(1);
-        let n_spoken = (0..steps_of)
+        let frame_steps = hands.len().saturating_sub(1);
+        let n_spoken = (0..frame_steps)
             .filter(|&i| in_syllable((i + 1) as f64 / fps))
             .count() as f64;
         let hs = speed_histogram_where(&hands, fps, in_syllable);
         let hp = speed_histogram_where(&hands, fps, |time| !in_syllable(time));
         for k in 0..26 {
             spoken[k] += n_spoken * hs[k];
-            paused[k] += (steps_of as f64 - n_spoken) * hp[k];
+            paused[k] += (frame_steps as f64 - n_spoken) * hp[k];
         }
     }
     mix_by_speech(&spoken, &paused, syllable_share(steps, seconds)).unwrap_or_else(whole)
