@@ -2,14 +2,14 @@
 //! (`motion.bvh`, the played poses on the library's skeleton, and `timeline.json`, the
 //! syllables and the segment entries), the same figures `gesture-train eval-motion` gives
 //! (`gesture_trainer::evaluate::metrics`). Any device that writes the same two files can be
-//! judged this way. With `--mocap`, the hands' speeds are compared with a capture's.
+//! judged this way. With `--mocap`, the hands' speeds are compared with a capture's, as the
+//! character shows it (no walking: `gesture_trainer::evaluate::motion::shown_speed_histogram`).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use gesture_trainer::evaluate::metrics::{
-    measure, speed_histogram, Entry, MotionMetrics, Speech, Trace,
-};
+use gesture_trainer::evaluate::metrics::{measure, Entry, MotionMetrics, Speech, Trace};
+use gesture_trainer::evaluate::motion::shown_speed_histogram;
 use gesture_trainer::evaluate::table::motion_table;
 use gesture_trainer::motion::{read_bvh, EffectorSpec};
 use serde::Deserialize;
@@ -89,9 +89,7 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
     let reference = match mocap {
         Some(p) => {
             let m = read_bvh(p).map_err(|e| SimError::Metrics(e.to_string()))?;
-            let t = Trace::from_motion(&m, &EffectorSpec::default(), Vec::new())
-                .map_err(|e| bad(p, e))?;
-            Some(speed_histogram(&t.hands, t.fps))
+            Some(shown_speed_histogram(&m, &EffectorSpec::default()).map_err(|e| bad(p, e))?)
         }
         None => None,
     };

@@ -23,8 +23,12 @@
 //!
 //! **The hand-speed reference.** With `--mocap`, the capture of the speech itself. Without
 //! one (another speaker's speech), [`speech_matched_reference`]: the library's capture in
-//! its syllables and in its pauses, weighed as the new speech has them. The library's whole
-//! capture, the reference before, rewarded playing the library's own mix of rest and motion
+//! its syllables and in its pauses, weighed as the new speech has them. Either is taken *as
+//! the character shows it* ([`translation_held`]: the lower body held as `pack` holds it,
+//! no translation): the hands of a speaker who walks or sways move faster in the world than
+//! any played motion can, since a blob holds rotations only (the 067 take's root moves at a
+//! median 8.5 cm/s; with it, its reference for beat-scott put 6.6 % of the frames below
+//! 10 cm/s, as shown 11.9 %). The library's whole capture, the reference before, rewarded playing the library's own mix of rest and motion
 //! whatever the speech: the 9-joint ZeroEGGS take rests through long pauses (a third of its
 //! frames below 10 cm/s) that a monologue does not have, so uniformly random choices were
 //! closest to it and a controller that gestures while the speaker talks was furthest.
@@ -55,8 +59,8 @@ use crate::control::mdp::Action;
 use crate::control::schedule::{play_dp, play_random, Played};
 use crate::inference::model::InferenceModel;
 use crate::inference::train::prosody_point;
-use crate::motion::{analyze, read_bvh, Motion, SegmentParams};
-use crate::pack::{pack_model, PackError, PackOptions};
+use crate::motion::{analyze, read_bvh, EffectorSpec, Motion, SegmentParams};
+use crate::pack::{hold_lower_bodies, pack_model, PackError, PackOptions};
 use crate::rig::PoseSkeleton;
 
 /// What to evaluate.
@@ -434,6 +438,44 @@ fn syllable_share(steps: &[Step], seconds: f64) -> f64 {
     (spoken / seconds.max(1e-9)).clamp(0.0, 1.0)
 }
 
+/// `m` with every translation channel held at its first frame's value: the capture as a
+/// blob's character shows it (a blob's frames hold rotations only; the character stays where
+/// it is). The hands' speeds in the capture itself include the speaker walking and swaying
+/// (the 067 take's root moves at a median 8.5 cm/s), which no played motion can show.
+pub fn translation_held(m: &Motion) -> Motion {
+    let (skeleton, frame_time, frames, mut data) = m.clone().into_parts();
+    let n = skeleton.channel_count();
+    let moves: Vec<usize> = skeleton
+        .joints
+        .iter()
+        .flat_map(|j| j.channels.iter())
+        .enumerate()
+        .filter(|(_, c)| !c.is_rotation())
+        .map(|(k, _)| k)
+        .collect();
+    if n > 0 && data.len() >= n {
+        let (first, rest) = data.split_at_mut(n);
+        for row in rest.chunks_mut(n) {
+            for &k in &moves {
+                row[k] = first[k];
+            }
+        }
+    }
+    Motion::new(skeleton, frame_time, frames, data)
+        .map(|held| held.with_source(m.source()))
+        .unwrap_or_else(|_| m.clone())
+}
+
+/// The hands' speed histogram of a capture as a blob's character shows it: the lower body
+/// held as `pack` holds a library's, then [`translation_held`]. The reference of a run
+/// against its speech's own capture (`eval-motion --mocap`, `gesture-sim metrics --mocap`).
+pub fn shown_speed_histogram(m: &Motion, effectors: &EffectorSpec) -> Result<Vec<f64>, String> {
+    let mut held = [m.clone()];
+    hold_lower_bodies(&mut held, effectors);
+    let t = Trace::from_motion(&translation_held(&held[0]), effectors, Vec::new())?;
+    Ok(speed_histogram(&t.hands, t.fps))
+}
+
 /// What the library's character does in speech like the new speech, as the reference of the
 /// hands' speeds when the speech has no capture of its own: the library's capture split
 /// into the frames spoken in syllables and those in pauses (its own speech, the WAV beside
@@ -447,21 +489,26 @@ pub fn speech_matched_reference(
     rate: u32,
     steps: &[Step],
     seconds: f64,
+    effectors: &EffectorSpec,
 ) -> Vec<f64> {
-    let hands_of = |t: &crate::control::library::LibTake| -> Vec<Vec<[f64; 3]>> {
-        let pos = &t.analysis.positions;
-        (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect()
-    };
-    let whole = || {
-        let mut hands = Vec::new();
-        for t in &lib.takes {
-            hands.extend(hands_of(t));
-        }
-        speed_histogram(&hands, lib.fps)
-    };
+    // The takes as the blob's character shows them (pack has held the library's lower
+    // bodies already).
+    let shown: Vec<Vec<Vec<[f64; 3]>>> = lib
+        .takes
+        .iter()
+        .map(|t| {
+            Trace::from_motion(&translation_held(&t.motion), effectors, Vec::new())
+                .map(|tr| tr.hands)
+                .unwrap_or_else(|_| {
+                    let pos = &t.analysis.positions;
+                    (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect()
+                })
+        })
+        .collect();
+    let whole = || speed_histogram(&shown.concat(), lib.fps);
     let mut spoken = vec![0.0; 26];
     let mut paused = vec![0.0; 26];
-    for t in &lib.takes {
+    for (t, hands) in lib.takes.iter().zip(&shown) {
         let wav = t.source.with_extension("wav");
         let Ok(pcm) = crate::audio::load_wav_at(&wav, rate) else {
             return whole();
@@ -479,15 +526,14 @@ pub fn speech_matched_reference(
             let k = spans.partition_point(|&(a, _)| a <= time);
             k > 0 && time < spans[k - 1].1
         };
-        let hands = hands_of(t);
         let fps = t.motion.fps();
         // Each take weighs by its frames in syllables and in pauses.
         let frame_steps = hands.len().saturating_sub(1);
         let n_spoken = (0..frame_steps)
             .filter(|&i| in_syllable((i + 1) as f64 / fps))
             .count() as f64;
-        let hs = speed_histogram_where(&hands, fps, in_syllable);
-        let hp = speed_histogram_where(&hands, fps, |time| !in_syllable(time));
+        let hs = speed_histogram_where(hands, fps, in_syllable);
+        let hp = speed_histogram_where(hands, fps, |time| !in_syllable(time));
         for k in 0..26 {
             spoken[k] += n_spoken * hs[k];
             paused[k] += (frame_steps as f64 - n_spoken) * hp[k];
@@ -542,9 +588,11 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     };
     // Hand speeds are compared with the speech's own capture when there is one, else with the
     // library's capture in speech like this (see `speech_matched_reference`).
+    // Both as the blob's character shows them (no walking; see `translation_held`).
     let ref_hist: Vec<f64> = match &reference {
-        Some((t, _)) => speed_histogram(&t.hands, t.fps),
-        None => speech_matched_reference(lib, &config, rate, &steps, seconds),
+        Some((t, mo)) => shown_speed_histogram(mo, &pack.effectors)
+            .unwrap_or_else(|_| speed_histogram(&t.hands, t.fps)),
+        None => speech_matched_reference(lib, &config, rate, &steps, seconds, &pack.effectors),
     };
     let segments = lib.segments.len();
     let measured = |p: &Playback| -> Result<MotionMetrics, EvalError> {
@@ -656,6 +704,41 @@ mod tests {
     use crate::inference::train::{fit, sequences, FitConfig};
     use crate::synth::{write_corpus, SynthParams};
     use gesture_runtime::prosody::Step;
+
+    #[test]
+    fn a_capture_as_shown_keeps_its_rotations_and_drops_its_walk() {
+        // A root walking 3 units per frame along X and turning 10 degrees per frame about Y,
+        // with an arm of length 2 along X: in the capture the hand moves by the walk plus
+        // the turn; held, only by the turn (a chord of 2 sin(5 deg) * 2 per frame).
+        let text = "HIERARCHY\nROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition \
+                    Zposition Zrotation Yrotation Xrotation\n\tJOINT RightHand\n\t{\n\t\t\
+                    OFFSET 2 0 0\n\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n\t\tEnd Site\n\
+                    \t\t{\n\t\t\tOFFSET 0 0 0\n\t\t}\n\t}\n}\nMOTION\nFrames: 3\n\
+                    Frame Time: 0.1\n0 5 0 0 0 0 0 0 0\n3 5 0 0 10 0 0 0 0\n6 5 0 0 20 0 0 0 0\n";
+        let m = crate::motion::parse_bvh(text, "walk.bvh").unwrap();
+        let held = translation_held(&m);
+        assert_eq!(held.source(), "walk.bvh");
+        for f in 0..3 {
+            let (a, b) = (m.frame(f).unwrap(), held.frame(f).unwrap());
+            // Translations are the first frame's; rotations untouched.
+            assert_eq!(&b[..3], &[0.0, 5.0, 0.0]);
+            assert_eq!(&b[3..], &a[3..]);
+        }
+        let hand = |mo: &Motion, f: usize| {
+            let p = crate::motion::FkPlan::new(mo.skeleton(), &[crate::motion::Target::Joint(1)])
+                .unwrap()
+                .positions(mo)
+                .unwrap();
+            p.frame(f)[0]
+        };
+        let step = |mo: &Motion| {
+            let (p, q) = (hand(mo, 1), hand(mo, 2));
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        };
+        let chord = 2.0 * 2.0 * (5.0f64.to_radians()).sin();
+        assert!((step(&held) - chord).abs() < 1e-9, "{}", step(&held));
+        assert!(step(&m) > 2.5, "the walk is in the capture: {}", step(&m));
+    }
 
     #[test]
     fn the_speech_matched_reference_weighs_speech_and_pauses_as_the_new_speech_has_them() {

@@ -598,9 +598,23 @@ pub fn tone_transforms(
 
 /// Holds the lower body of the library's takes (see [`plant`]); `None` without feet.
 fn hold_lower_body(lib: &mut Library, effectors: &EffectorSpec) -> Option<plant::Planted> {
-    let first = lib.takes.first()?;
+    let mut motions: Vec<Motion> = lib.takes.iter().map(|t| t.motion.clone()).collect();
+    let planted = hold_lower_bodies(&mut motions, effectors)?;
+    for (t, m) in lib.takes.iter_mut().zip(motions) {
+        t.motion = m;
+    }
+    Some(planted)
+}
+
+/// Holds the lower body of `motions` (one skeleton) as `pack` holds a library's (see
+/// [`plant`]); `None`, and the motions untouched, without feet or hands.
+pub fn hold_lower_bodies(
+    motions: &mut [Motion],
+    effectors: &EffectorSpec,
+) -> Option<plant::Planted> {
+    let first = motions.first()?;
     let hands: Vec<usize> = effectors
-        .resolve(first.motion.skeleton(), first.motion.source())
+        .resolve(first.skeleton(), first.source())
         .ok()?
         .targets
         .iter()
@@ -608,12 +622,7 @@ fn hold_lower_body(lib: &mut Library, effectors: &EffectorSpec) -> Option<plant:
             Target::Joint(j) | Target::EndSite(j) => j,
         })
         .collect();
-    let mut motions: Vec<Motion> = lib.takes.iter().map(|t| t.motion.clone()).collect();
-    let planted = plant::plant_feet(&mut motions, &hands)?;
-    for (t, m) in lib.takes.iter_mut().zip(motions) {
-        t.motion = m;
-    }
-    Some(planted)
+    plant::plant_feet(motions, &hands)
 }
 
 /// Loads the model at `model_path`, packs it with the BVH files in `library` and writes the
