@@ -321,3 +321,218 @@ fn fig4_on_the_real_take_crf_beats_hmm_and_prior_for_every_window() {
         }
     }
 }
+
+fn synthetic_takes(minutes: f64) -> (tempfile::TempDir, gesture_trainer::corpus::Corpus) {
+    let dir = tempfile::tempdir().unwrap();
+    let params = SynthParams {
+        minutes,
+        seed: 7,
+        take_seconds: 60.0,
+    };
+    write_corpus(&params, dir.path(), |_, _| {}).unwrap();
+    let corpus = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
+    (dir, corpus)
+}
+
+#[test]
+fn cross_validation_holds_each_span_out_once_and_purges_the_segments_reaching_into_it() {
+    use gesture_trainer::inference::train::cv_split;
+    let (_dir, corpus) = synthetic_takes(2.0);
+    assert_eq!(corpus.takes.len(), 2);
+    let (take, other) = (&corpus.takes[0], &corpus.takes[1]);
+    let dt = take.motion.frame_time;
+    let mut tested = Vec::new();
+    for k in 0..3 {
+        let split = cv_split(&corpus, k, 3, |s| s == take.stem);
+        let len = take.motion_s();
+        let lo = len * k as f64 / 3.0;
+        let hi = if k == 2 {
+            f64::INFINITY
+        } else {
+            len * (k + 1) as f64 / 3.0
+        };
+        // Only the named take is held out, and only steps whose midpoint is in the span.
+        assert_eq!(split.test.len(), 1);
+        assert_eq!(split.test[0].stem, take.stem);
+        for &(a, b) in &split.test[0].times {
+            let mid = 0.5 * (a + b);
+            assert!(mid >= lo && mid < hi, "fold {k}: step {a}-{b}");
+        }
+        tested.extend(split.test[0].times.iter().copied());
+        // The other take trains whole, as one sequence.
+        let others: Vec<_> = split
+            .train
+            .iter()
+            .filter(|s| s.stem == other.stem)
+            .collect();
+        assert_eq!(others.len(), 1);
+        assert_eq!(others[0].len(), other.aligned.len());
+        // No training step of the held-out take overlaps a motion segment that reaches into
+        // the span; a middle span leaves two pieces, the first and last one piece.
+        let reaching: Vec<(f64, f64)> = take
+            .motion
+            .segments
+            .iter()
+            .map(|g| (g.start_frame as f64 * dt, g.end_frame as f64 * dt))
+            .filter(|&(g0, g1)| g0 < hi && g1 > lo)
+            .collect();
+        assert!(!reaching.is_empty());
+        let pieces: Vec<_> = split.train.iter().filter(|s| s.stem == take.stem).collect();
+        assert_eq!(pieces.len(), if k == 1 { 2 } else { 1 }, "fold {k}");
+        for p in &pieces {
+            for &(a, b) in &p.times {
+                for &(g0, g1) in &reaching {
+                    assert!(!(a < g1 && b > g0), "fold {k}: step {a}-{b} in {g0}-{g1}");
+                }
+            }
+        }
+        if k == 1 {
+            assert!(pieces[0].times.last().unwrap().1 <= pieces[1].times[0].0);
+        }
+        // Training steps plus held-out steps are fewer than the take's (some purged), and
+        // the normalization sees only training segments: the other take's and fewer of this.
+        let trained: usize = pieces.iter().map(|p| p.len()).sum();
+        assert!(trained + split.test[0].len() < take.aligned.len());
+        assert!(split.segments.len() < take.motion.segments.len() + other.motion.segments.len());
+        assert!(split.segments.len() >= other.motion.segments.len());
+    }
+    // Every step of the take is held out exactly once over the folds.
+    let all: Vec<(f64, f64)> = take
+        .aligned
+        .iter()
+        .map(|a| (a.step.start_s(), a.step.end_s()))
+        .collect();
+    assert_eq!(tested, all);
+}
+
+#[test]
+fn cross_validated_fig4_pools_the_folds_and_the_crf_beats_the_prior() {
+    use clap::Parser;
+    #[derive(clap::Parser)]
+    struct W {
+        #[command(flatten)]
+        a: gesture_trainer::cli::eval_inference::EvalArgs,
+    }
+    let (dir, _) = synthetic_takes(6.0);
+    let d = dir.path().to_str().unwrap();
+    let mut args = W::parse_from(["x", "--train", d, "--folds", "3", "--windows", "1,4"]).a;
+    // Fixed S, K and regularization: the folds' model selection is `fit`'s, tested elsewhere.
+    args.model.states = Some(4);
+    args.model.clusters = Some(4);
+    args.model.l2 = Some(0.01);
+    args.model.lag_penalty = Some(1.0);
+    args.model.restarts = 4;
+    let r = gesture_trainer::cli::eval_inference::cross_validate(&args).unwrap();
+    assert_eq!(r.folds.len(), 3);
+    let steps: usize = r.folds.iter().map(|f| f.test_steps).sum();
+    let all = all_steps(d);
+    assert_eq!(steps, all, "every step held out once");
+    for (i, row) in r.rows.iter().enumerate() {
+        // Pooled over the held-out steps, and the folds' gains with their standard error.
+        let crf: f64 = r
+            .folds
+            .iter()
+            .map(|f| f.rows[i].crf * f.test_steps as f64)
+            .sum::<f64>()
+            / steps as f64;
+        let prior: f64 = r
+            .folds
+            .iter()
+            .map(|f| f.rows[i].prior * f.test_steps as f64)
+            .sum::<f64>()
+            / steps as f64;
+        assert!((row.crf - crf).abs() < 1e-9 && (row.gain - (crf - prior)).abs() < 1e-9);
+        let g: Vec<f64> = r.folds.iter().map(|f| f.rows[i].gain).collect();
+        assert_eq!(row.fold_gains, g);
+        let m = g.iter().sum::<f64>() / 3.0;
+        let se = (g.iter().map(|x| (x - m).powi(2)).sum::<f64>() / 2.0 / 3.0).sqrt();
+        assert!((row.gain_se - se).abs() < 1e-12);
+        // The planted states are audible: the CRF beats the prior on held-out spans.
+        assert!(row.gain > 0.1, "window {}: {row:?}", row.window);
+    }
+    // --test must name training takes; spans and folds exclude each other.
+    let other = tempfile::tempdir().unwrap();
+    for ext in ["bvh", "wav"] {
+        std::fs::copy(
+            dir.path().join(format!("take_000.{ext}")),
+            other.path().join(format!("elsewhere.{ext}")),
+        )
+        .unwrap();
+    }
+    let bad = W::parse_from([
+        "x",
+        "--train",
+        d,
+        "--test",
+        other.path().to_str().unwrap(),
+        "--folds",
+        "3",
+    ])
+    .a;
+    let err = gesture_trainer::cli::eval_inference::cross_validate(&bad).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("elsewhere is not among the --train takes"),
+        "{err}"
+    );
+    assert!(
+        W::try_parse_from(["x", "--train", d, "--folds", "3", "--train-span", "0:30"]).is_err()
+    );
+    assert!(
+        W::try_parse_from(["x", "--train", d]).is_err(),
+        "--test or --folds"
+    );
+}
+
+fn all_steps(d: &str) -> usize {
+    load_corpus(&[PathBuf::from(d)], &LoadOptions::default())
+        .unwrap()
+        .takes
+        .iter()
+        .map(|t| t.aligned.len())
+        .sum()
+}
+
+#[test]
+fn cross_validated_on_the_9_joint_take_the_crf_beats_hmm_and_prior_alone_and_pooled() {
+    use clap::Parser;
+    #[derive(clap::Parser)]
+    struct W {
+        #[command(flatten)]
+        a: gesture_trainer::cli::eval_inference::EvalArgs,
+    }
+    let test = "cross_validated_on_the_9_joint_take_the_crf_beats_hmm_and_prior_alone_and_pooled";
+    let (Some(nine), Some(other)) = (
+        e2e_tests::shared_data(test, "zeroeggs-001-neutral-9joint"),
+        zeroeggs(test),
+    ) else {
+        return;
+    };
+    let (nine, other) = (nine.to_str().unwrap(), other.to_str().unwrap());
+    // Default options (model selection in every fold), each quarter of the 9-joint take
+    // held out in turn; pooled, the 067 take trains in every fold.
+    let runs = [
+        vec!["x", "--train", nine, "--folds", "4", "--windows", "1,4"],
+        vec![
+            "x",
+            "--train",
+            nine,
+            other,
+            "--test",
+            nine,
+            "--folds",
+            "4",
+            "--windows",
+            "1,4",
+        ],
+    ];
+    for argv in runs {
+        let a = W::parse_from(&argv).a;
+        let r = gesture_trainer::cli::eval_inference::cross_validate(&a).unwrap();
+        for row in &r.rows {
+            eprintln!("{argv:?} {row:?}");
+            assert!(row.crf > row.hmm, "{row:?}");
+            assert!(row.gain > 0.2 && row.gain > 3.0 * row.gain_se, "{row:?}");
+        }
+    }
+}

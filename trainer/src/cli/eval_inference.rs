@@ -8,6 +8,16 @@
 //!
 //! When a training folder holds a synthetic corpus's `truth.json`, the adjusted Rand index
 //! between the HMM's most likely states and the planted states is reported too.
+//!
+//! **Cross-validation over time** (`--folds N`): instead of a test corpus, each take (or
+//! each take of `--test`, which must be among the training takes) is cut into N spans of
+//! equal length and each span is held out in turn, the model trained on everything else
+//! (less the steps sharing a motion segment with the held-out span;
+//! `inference::train::cv_split`), model selection included. Rows are means over all held-out
+//! steps; the gain's standard error comes from the spread of the folds' gains, and each
+//! fold's gain is printed (`fold_gains` in the JSON, with every fold's report under
+//! `folds`). One split is one draw: on the 9-joint take (4 folds, W = 4) the folds' gains
+//! range over +0.36 to +0.40.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -15,8 +25,8 @@ use std::path::{Path, PathBuf};
 use super::args::{parse_span, CorpusArgs, ModelArgs};
 use super::CliError;
 use crate::corpus::load_corpus;
-use crate::inference::eval::{self, EvalReport, PlantedRuns};
-use crate::inference::train::sequences;
+use crate::inference::eval::{self, CvReport, EvalReport, PlantedRuns};
+use crate::inference::train::{cv_split, sequences};
 
 /// Arguments of `eval-inference`.
 #[derive(Debug, clap::Args)]
@@ -24,9 +34,14 @@ pub struct EvalArgs {
     /// Training corpus (files or folders).
     #[arg(long, required = true, num_args = 1..)]
     pub train: Vec<PathBuf>,
-    /// Test corpus (files or folders).
-    #[arg(long, required = true, num_args = 1..)]
+    /// Test corpus (files or folders); with `--folds`, the training takes to hold spans of
+    /// out (default: every training take).
+    #[arg(long, required_unless_present = "folds", num_args = 1..)]
     pub test: Vec<PathBuf>,
+    /// Cross-validate over time: hold out each of N equal spans of each (test) take in
+    /// turn, training on the rest.
+    #[arg(long, value_parser = |s: &str| super::args::count(s, 2, 10), conflicts_with_all = ["train_span", "test_span"])]
+    pub folds: Option<usize>,
     /// CRF windows to compare.
     #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2, 3, 4, 5], value_parser = |s: &str| super::args::count(s, 1, gesture_runtime::inference::MAX_WINDOW))]
     pub windows: Vec<usize>,
@@ -85,13 +100,7 @@ pub fn evaluate(a: &EvalArgs) -> Result<EvalReport, CliError> {
     };
     let (train_seqs, segs) = sequences(&train, a.train_span);
     let (test_seqs, _) = sequences(&test, a.test_span);
-    // S and K are chosen with the paper's window (4) when it is compared, as `fit` does.
-    let w = if a.windows.contains(&4) {
-        4
-    } else {
-        a.windows.first().copied().unwrap_or(4)
-    };
-    let cfg = a.model.config(w);
+    let cfg = a.model.config(selection_window(a));
     let (train_runs, test_runs) = (planted_runs(&a.train), planted_runs(&a.test));
     Ok(eval::evaluate(
         (&train_seqs, &segs),
@@ -103,8 +112,104 @@ pub fn evaluate(a: &EvalArgs) -> Result<EvalReport, CliError> {
     )?)
 }
 
+/// The paper's window when compared, else the first: S and K are chosen with it, as `fit`
+/// does.
+fn selection_window(a: &EvalArgs) -> usize {
+    if a.windows.contains(&4) {
+        4
+    } else {
+        a.windows.first().copied().unwrap_or(4)
+    }
+}
+
+/// Loads the training corpus and runs [`crate::inference::eval::cross_validate`] with
+/// `--folds` (see the module docs).
+pub fn cross_validate(a: &EvalArgs) -> Result<CvReport, CliError> {
+    let folds = a
+        .folds
+        .ok_or_else(|| CliError::Input("cross-validation needs --folds N".into()))?;
+    let opts = a.load.options();
+    let train = load_corpus(&a.train, &opts)?;
+    let held: Vec<String> = if a.test.is_empty() {
+        train.takes.iter().map(|t| t.stem.clone()).collect()
+    } else {
+        let test = load_corpus(&a.test, &opts)?;
+        let mut stems = Vec::new();
+        for t in &test.takes {
+            if !train.takes.iter().any(|u| u.stem == t.stem) {
+                return Err(CliError::Input(format!(
+                    "--test take {} is not among the --train takes (with --folds, --test names \
+                     the training takes to hold spans of out)",
+                    t.stem
+                )));
+            }
+            stems.push(t.stem.clone());
+        }
+        stems
+    };
+    let splits: Vec<_> = (0..folds)
+        .map(|k| cv_split(&train, k, folds, |stem| held.iter().any(|h| h == stem)))
+        .collect();
+    let cfg = a.model.config(selection_window(a));
+    Ok(eval::cross_validate(&splits, &cfg, &a.windows, &|line| {
+        eprintln!("{line}")
+    })?)
+}
+
+fn run_folds(a: &EvalArgs) -> Result<(), CliError> {
+    let r = cross_validate(a)?;
+    let train: usize = r.folds.iter().map(|f| f.train_steps).sum::<usize>() / r.folds.len().max(1);
+    let test: usize = r.folds.iter().map(|f| f.test_steps).sum();
+    let models: Vec<String> = r
+        .folds
+        .iter()
+        .map(|f| format!("S={} K={}", f.states, f.clusters))
+        .collect();
+    let extras = format!(
+        "{} folds: {test} test steps in all, about {train} training steps each; models {}; \
+         {:.2} s",
+        r.folds.len(),
+        models.join(", "),
+        r.seconds
+    );
+    if a.json {
+        eprintln!("{extras}");
+        outln!("{}", serde_json::to_string(&r)?)?;
+        return Ok(());
+    }
+    outln!("mean log-likelihood per held-out step of the true kinematic parameters, all folds")?;
+    outln!(
+        "{:>6} {:>10} {:>10} {:>10} {:>10} {:>7}  {}",
+        "window",
+        "crf",
+        "hmm",
+        "prior",
+        "gain",
+        "+-se",
+        "gain per fold"
+    )?;
+    for w in &r.rows {
+        let per: Vec<String> = w.fold_gains.iter().map(|g| format!("{g:+.3}")).collect();
+        outln!(
+            "{:>6} {:>10.3} {:>10.3} {:>10.3} {:>+10.3} {:>7.3}  {}",
+            w.window,
+            w.crf,
+            w.hmm,
+            w.prior,
+            w.gain,
+            w.gain_se,
+            per.join(" ")
+        )?;
+    }
+    outln!("{extras}")?;
+    Ok(())
+}
+
 /// Runs the command.
 pub fn run(a: &EvalArgs) -> Result<(), CliError> {
+    if a.folds.is_some() {
+        return run_folds(a);
+    }
     let r = evaluate(a)?;
     let mut extras = format!(
         "train {} steps, test {} steps, S={} K={}; {:.2} s",

@@ -83,6 +83,109 @@ pub struct EvalReport {
     pub seconds: f64,
 }
 
+/// One window's figures over the folds of a cross-validation ([`cross_validate`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct CvRow {
+    /// Window W.
+    pub window: usize,
+    /// CRF, mean log-likelihood per test step over every fold's test steps.
+    pub crf: f64,
+    /// Brand's remapped HMM, likewise.
+    pub hmm: f64,
+    /// State prior, likewise.
+    pub prior: f64,
+    /// `crf - prior` (nats per step).
+    pub gain: f64,
+    /// Standard error of `gain` from the folds: the standard deviation of the folds' gains
+    /// over the square root of their number.
+    pub gain_se: f64,
+    /// Each fold's gain.
+    pub fold_gains: Vec<f64>,
+}
+
+/// A cross-validation over time: every fold's report and the windows' figures over all.
+#[derive(Debug, Clone, Serialize)]
+pub struct CvReport {
+    /// One row per window.
+    pub rows: Vec<CvRow>,
+    /// Each fold's evaluation (its model selection included).
+    pub folds: Vec<EvalReport>,
+    /// Wall time (s).
+    #[serde(skip)]
+    pub seconds: f64,
+}
+
+/// Runs [`evaluate`] on each fold of `splits` (from [`super::train::cv_split`]; model
+/// selection inside each fold, on its training data only) and pools the folds: per window
+/// the mean scores over all test steps, the gain's standard error from the spread of the
+/// folds' gains. A fold without test steps is an error naming it.
+pub fn cross_validate(
+    splits: &[super::train::CvSplit],
+    cfg: &FitConfig,
+    windows: &[usize],
+    log: &(dyn Fn(&str) + Sync),
+) -> Result<CvReport, FitError> {
+    let start = Instant::now();
+    let mut folds = Vec::with_capacity(splits.len());
+    for (k, split) in splits.iter().enumerate() {
+        log(&format!("fold {} of {}", k + 1, splits.len()));
+        let r = evaluate(
+            (&split.train, &split.segments),
+            &split.test,
+            cfg,
+            windows,
+            (None, None),
+            log,
+        )
+        .map_err(|e| match e {
+            FitError::Settings(m) => FitError::Settings(format!("fold {}: {m}", k + 1)),
+            other => other,
+        })?;
+        folds.push(r);
+    }
+    let steps: f64 = folds
+        .iter()
+        .map(|f| f.test_steps as f64)
+        .sum::<f64>()
+        .max(1.0);
+    let rows = windows
+        .iter()
+        .enumerate()
+        .map(|(i, &window)| {
+            let pooled = |v: fn(&Row) -> f64| {
+                folds
+                    .iter()
+                    .map(|f| v(&f.rows[i]) * f.test_steps as f64)
+                    .sum::<f64>()
+                    / steps
+            };
+            let fold_gains: Vec<f64> = folds.iter().map(|f| f.rows[i].gain).collect();
+            let n = fold_gains.len() as f64;
+            let m = fold_gains.iter().sum::<f64>() / n.max(1.0);
+            let gain_se = if fold_gains.len() < 2 {
+                0.0
+            } else {
+                (fold_gains.iter().map(|g| (g - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
+            };
+            let (crf, prior) = (pooled(|r| r.crf), pooled(|r| r.prior));
+            CvRow {
+                window,
+                crf,
+                hmm: pooled(|r| r.hmm),
+                prior,
+                gain: crf - prior,
+                gain_se,
+                fold_gains,
+            }
+        })
+        .collect();
+    Ok(CvReport {
+        rows,
+        folds,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
 /// Fits on `train` (S and K chosen once with window `cfg.window` when open), then for each of
 /// `windows` fits the CRF (regularization chosen per window when open) and Brand's remapped
 /// HMM, and scores their online beliefs and the prior on `test`.

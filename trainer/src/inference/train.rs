@@ -88,6 +88,101 @@ pub fn sequences(corpus: &Corpus, span: Option<(f64, f64)>) -> (Vec<Sequence>, V
     (seqs, segs)
 }
 
+/// One fold of a cross-validation over time ([`cv_split`]).
+#[derive(Clone, Debug, Default)]
+pub struct CvSplit {
+    /// Training sequences: every step of the takes not held out, and the steps of the held-out
+    /// takes before and after the held-out span (separate sequences), less the steps that
+    /// share a motion segment with it.
+    pub train: Vec<Sequence>,
+    /// Log kinematic vectors of the training segments (for the normalization).
+    pub segments: Vec<[f64; 6]>,
+    /// The held-out steps.
+    pub test: Vec<Sequence>,
+}
+
+/// Fold `fold` of `folds` over time: each take whose stem `held` accepts has the span
+/// `[fold, fold + 1) / folds` of its motion held out (steps by their midpoint); training
+/// keeps the rest of the corpus, less every step and segment that overlaps a motion segment
+/// reaching into the held-out span (purged, as model selection's folds are: a segment spans
+/// several steps, so its neighbours would carry the held-out motion into training).
+pub fn cv_split(
+    corpus: &Corpus,
+    fold: usize,
+    folds: usize,
+    held: impl Fn(&str) -> bool,
+) -> CvSplit {
+    let mut out = CvSplit::default();
+    let folds = folds.max(1);
+    for t in &corpus.takes {
+        let dt = t.motion.frame_time;
+        let segs: Vec<(f64, f64)> = t
+            .motion
+            .segments
+            .iter()
+            .map(|g| (g.start_frame as f64 * dt, g.end_frame as f64 * dt))
+            .collect();
+        let (lo, hi, plo, phi) = if held(&t.stem) {
+            let len = t.motion_s();
+            // The last span takes whatever lies past the motion's end too (audio a little
+            // longer than the motion), so every step is held out once.
+            let hi = if fold + 1 >= folds {
+                f64::INFINITY
+            } else {
+                len * (fold + 1) as f64 / folds as f64
+            };
+            let lo = len * fold as f64 / folds as f64;
+            let (mut plo, mut phi) = (lo, hi);
+            for &(g0, g1) in &segs {
+                if g0 < hi && g1 > lo {
+                    plo = plo.min(g0);
+                    phi = phi.max(g1);
+                }
+            }
+            (lo, hi, plo, phi)
+        } else {
+            (f64::NAN, f64::NAN, f64::NAN, f64::NAN)
+        };
+        let is_held = |a: f64, b: f64| {
+            let mid = 0.5 * (a + b);
+            mid >= lo && mid < hi
+        };
+        let is_purged = |a: f64, b: f64| a < phi && b > plo;
+        let empty = || Sequence {
+            stem: t.stem.clone(),
+            segments: segs.clone(),
+            ..Sequence::default()
+        };
+        let (mut before, mut after, mut test) = (empty(), empty(), empty());
+        for a in &t.aligned {
+            let (t0, t1) = (a.step.start_s(), a.step.end_s());
+            let into = if is_held(t0, t1) {
+                &mut test
+            } else if is_purged(t0, t1) {
+                continue;
+            } else if t0 >= phi {
+                &mut after
+            } else {
+                &mut before
+            };
+            into.features.push(a.features);
+            into.y_raw.push(a.y_raw);
+            into.times.push((t0, t1));
+        }
+        for (&(g0, g1), y) in segs.iter().zip(&t.motion.y_raw) {
+            if !is_purged(g0, g1) {
+                out.segments.push(*y);
+            }
+        }
+        out.train
+            .extend([before, after].into_iter().filter(|s| !s.is_empty()));
+        if !test.is_empty() {
+            out.test.push(test);
+        }
+    }
+    out
+}
+
 /// The mixture's view of a step.
 pub fn prosody_point(f: &StepFeatures) -> ProsodyPoint {
     ProsodyPoint {
