@@ -26,7 +26,7 @@ use super::args::{parse_span, CorpusArgs, ModelArgs};
 use super::CliError;
 use crate::corpus::load_corpus;
 use crate::inference::eval::{self, CvReport, EvalReport, PlantedRuns};
-use crate::inference::train::{cv_split, sequences};
+use crate::inference::train::{cv_split, sequences, sequences_with_levels, take_levels};
 
 /// Arguments of `eval-inference`.
 #[derive(Debug, clap::Args)]
@@ -99,7 +99,9 @@ pub fn evaluate(a: &EvalArgs) -> Result<EvalReport, CliError> {
         load_corpus(&a.test, &opts)?
     };
     let (train_seqs, segs) = sequences(&train, a.train_span);
-    let (test_seqs, _) = sequences(&test, a.test_span);
+    // A test span of a training take is standardized by the training span's level.
+    let levels = take_levels(&train, a.train_span);
+    let (test_seqs, _) = sequences_with_levels(&test, a.test_span, &levels);
     let cfg = a.model.config(selection_window(a));
     let (train_runs, test_runs) = (planted_runs(&a.train), planted_runs(&a.test));
     Ok(eval::evaluate(

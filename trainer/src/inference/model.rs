@@ -197,6 +197,11 @@ pub struct ModelFile {
     pub front_end: FrontEndFile,
     /// Normalization of the log kinematic parameters (T, D, V, A, C, H).
     pub normalization: Normalization,
+    /// Present when the training takes' kinematics were standardized each by its own level
+    /// (see [`InferenceModel::take_level`]): the training takes' typical level. Absent in
+    /// models from before it (their libraries are normalized as they were).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub take_level: Option<Normalization>,
     /// HMM.
     pub hmm: HmmFile,
     /// Prosody mixture.
@@ -216,8 +221,17 @@ pub struct InferenceModel {
     pub sample_rate_hz: u32,
     /// The front-end settings the features were computed with.
     pub prosody: ProsodyConfig,
-    /// Kinematic normalization.
+    /// Kinematic normalization (of the kinematics standardized per take, when `take_level`
+    /// is set).
     pub normalization: Normalization,
+    /// Each training take's log kinematic parameters were standardized by that take's own
+    /// mean and spread (its *level*: how energetic that recording is) before anything else, so
+    /// the states describe how a performance varies, not which recording it is, and takes of
+    /// one speaker in other sessions, styles or skeletons pool. A library is then put in the
+    /// same terms by its own level ([`InferenceModel::library_normalization`]). This is the
+    /// training takes' typical level (the step-weighted mean of their levels), for a library
+    /// too small to have one. `None` for models from before it.
+    pub take_level: Option<Normalization>,
     /// HMM.
     pub hmm: Hmm,
     /// Prosody mixture.
@@ -261,10 +275,33 @@ pub enum ModelError {
     },
 }
 
+/// Fewest segments a library needs to be standardized by its own level; a smaller one takes
+/// the model's training level.
+pub const MIN_LEVEL_SEGMENTS: usize = 8;
+
 impl InferenceModel {
     /// Number of hidden states.
     pub fn states(&self) -> usize {
         self.hmm.states()
+    }
+
+    /// The normalization of a library whose segments' log kinematic parameters are `raw`
+    /// (all of its segments, every take): with a per-take model, the library's own level
+    /// (its segments' mean and spread; the model's training level when it has fewer than
+    /// [`MIN_LEVEL_SEGMENTS`]) followed by the model's normalization; otherwise the model's
+    /// normalization alone. A library is one performance: a take, or one character's clips.
+    pub fn library_normalization(&self, raw: &[[f64; 6]]) -> Normalization {
+        match &self.take_level {
+            None => self.normalization,
+            Some(reference) => {
+                let level = if raw.len() >= MIN_LEVEL_SEGMENTS {
+                    Normalization::fit(raw).unwrap_or(*reference)
+                } else {
+                    *reference
+                };
+                level.then(&self.normalization)
+            }
+        }
     }
 
     /// The file form.
@@ -274,6 +311,7 @@ impl InferenceModel {
             version: VERSION,
             front_end: FrontEndFile::from(&self.prosody),
             normalization: self.normalization,
+            take_level: self.take_level,
             hmm: HmmFile {
                 init: self.hmm.init.clone(),
                 trans: self.hmm.trans.clone(),
@@ -368,6 +406,7 @@ impl InferenceModel {
             sample_rate_hz: prosody.sample_rate_hz,
             prosody,
             normalization: f.normalization,
+            take_level: f.take_level,
             hmm: Hmm {
                 init: f.hmm.init,
                 trans: f.hmm.trans,

@@ -549,6 +549,7 @@ mod tests {
             y_raw: vec![[0.0; 6]; n],
             times,
             segments: segs,
+            ..Sequence::default()
         }
     }
 

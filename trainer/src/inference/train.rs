@@ -3,6 +3,7 @@
 //! fixed HMM posteriors. What the settings leave open (S, K, the CRF's regularization) is
 //! chosen first by held-out likelihood ([`super::select`]).
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use gesture_runtime::inference::StepFeatures;
@@ -10,7 +11,7 @@ use gesture_runtime::inference::StepFeatures;
 use super::crf::{Crf, CrfConfig, TrainSeq};
 use super::gmm::{Gmm, GmmConfig, ProsodyPoint};
 use super::hmm::{Hmm, HmmConfig, HmmError, Seq};
-use super::model::InferenceModel;
+use super::model::{InferenceModel, MIN_LEVEL_SEGMENTS};
 use super::select::{self, Selection};
 use crate::corpus::Corpus;
 use crate::motion::Normalization;
@@ -22,13 +23,18 @@ pub struct Sequence {
     pub stem: String,
     /// Normalized prosody features per step (from the runtime).
     pub features: Vec<StepFeatures>,
-    /// Log kinematic target per step (not normalized).
+    /// Log kinematic target per step, standardized by its take's level (see `level`), not yet
+    /// by the model's normalization.
     pub y_raw: Vec<[f64; 6]>,
     /// Step start and end times (s).
     pub times: Vec<(f64, f64)>,
     /// Start and end times (s) of the take's motion segments (for purging held-out data,
     /// see [`super::select`]).
     pub segments: Vec<(f64, f64)>,
+    /// The take's level: the mean and spread of its segments' log kinematic parameters (in
+    /// the span used for training), which `y_raw` is standardized by
+    /// ([`super::model::InferenceModel::take_level`]).
+    pub level: Normalization,
 }
 
 impl Sequence {
@@ -49,38 +55,107 @@ impl Sequence {
             y_raw: self.y_raw[range.clone()].to_vec(),
             times: self.times[range].to_vec(),
             segments: self.segments.clone(),
+            level: self.level,
         }
     }
 }
 
+/// A take's level from the log kinematic parameters `raw` of its segments: their mean and
+/// spread, or `fallback` with fewer than [`MIN_LEVEL_SEGMENTS`] of them.
+fn level_of(raw: &[[f64; 6]], fallback: Normalization) -> Normalization {
+    if raw.len() >= MIN_LEVEL_SEGMENTS {
+        Normalization::fit(raw).unwrap_or(fallback)
+    } else {
+        fallback
+    }
+}
+
+/// The segments of a take inside `span` (by midpoint): `(start_s, end_s, raw vector)`.
+fn take_segments(
+    t: &crate::corpus::LoadedTake,
+    inside: impl Fn(f64, f64) -> bool,
+) -> Vec<(f64, f64, [f64; 6])> {
+    let dt = t.motion.frame_time;
+    t.motion
+        .segments
+        .iter()
+        .zip(&t.motion.y_raw)
+        .map(|(g, y)| (g.start_frame as f64 * dt, g.end_frame as f64 * dt, *y))
+        .filter(|&(g0, g1, _)| inside(g0, g1))
+        .collect()
+}
+
+fn in_span(span: Option<(f64, f64)>) -> impl Fn(f64, f64) -> bool {
+    move |a: f64, b: f64| span.is_none_or(|(s0, s1)| (0.5 * (a + b)) >= s0 && (0.5 * (a + b)) < s1)
+}
+
+/// Each take's level ([`super::model::InferenceModel::take_level`]) from its segments inside
+/// `span`; a take with too few takes the level of all of them together.
+pub fn take_levels(corpus: &Corpus, span: Option<(f64, f64)>) -> HashMap<String, Normalization> {
+    let inside = in_span(span);
+    let per_take: Vec<(String, Vec<[f64; 6]>)> = corpus
+        .takes
+        .iter()
+        .map(|t| {
+            let raw = take_segments(t, &inside).into_iter().map(|g| g.2).collect();
+            (t.stem.clone(), raw)
+        })
+        .collect();
+    let all: Vec<[f64; 6]> = per_take
+        .iter()
+        .flat_map(|(_, r)| r.iter().copied())
+        .collect();
+    let pooled = level_of(&all, Normalization::identity());
+    per_take
+        .into_iter()
+        .map(|(stem, raw)| (stem, level_of(&raw, pooled)))
+        .collect()
+}
+
 /// The sequences of a corpus, keeping steps whose midpoint lies in `span` (seconds), and the
-/// log kinematic vectors of the segments inside the span (for the normalization).
+/// log kinematic vectors of the segments inside the span (for the normalization), each take
+/// standardized by its level ([`take_levels`] over the same span).
 pub fn sequences(corpus: &Corpus, span: Option<(f64, f64)>) -> (Vec<Sequence>, Vec<[f64; 6]>) {
-    let inside =
-        |a: f64, b: f64| span.is_none_or(|(s0, s1)| (0.5 * (a + b)) >= s0 && (0.5 * (a + b)) < s1);
+    sequences_with_levels(corpus, span, &take_levels(corpus, span))
+}
+
+/// [`sequences`] with given take levels: a take named in `levels` is standardized by that
+/// level (a test span of a training take, by the training span's), any other by its own
+/// segments inside `span`.
+pub fn sequences_with_levels(
+    corpus: &Corpus,
+    span: Option<(f64, f64)>,
+    levels: &HashMap<String, Normalization>,
+) -> (Vec<Sequence>, Vec<[f64; 6]>) {
+    let own = take_levels(corpus, span);
+    let inside = in_span(span);
     let mut seqs = Vec::new();
     let mut segs = Vec::new();
     for t in &corpus.takes {
+        let level = levels
+            .get(&t.stem)
+            .or_else(|| own.get(&t.stem))
+            .copied()
+            .unwrap_or_else(Normalization::identity);
         let mut s = Sequence {
             stem: t.stem.clone(),
+            level,
             ..Sequence::default()
         };
         for a in &t.aligned {
             let (t0, t1) = (a.step.start_s(), a.step.end_s());
             if inside(t0, t1) {
                 s.features.push(a.features);
-                s.y_raw.push(a.y_raw);
+                s.y_raw.push(level.apply(&a.y_raw));
                 s.times.push((t0, t1));
             }
         }
         let dt = t.motion.frame_time;
-        for (g, y) in t.motion.segments.iter().zip(&t.motion.y_raw) {
-            let (g0, g1) = (g.start_frame as f64 * dt, g.end_frame as f64 * dt);
-            s.segments.push((g0, g1));
-            if inside(g0, g1) {
-                segs.push(*y);
-            }
+        for g in &t.motion.segments {
+            s.segments
+                .push((g.start_frame as f64 * dt, g.end_frame as f64 * dt));
         }
+        segs.extend(take_segments(t, &inside).iter().map(|g| level.apply(&g.2)));
         if !s.is_empty() {
             seqs.push(s);
         }
@@ -114,6 +189,9 @@ pub fn cv_split(
 ) -> CvSplit {
     let mut out = CvSplit::default();
     let folds = folds.max(1);
+    // Each take is standardized by the level of its training segments (the held-out span's
+    // own kinematics are not looked at); a take with too few, by all training segments'.
+    let mut parts = Vec::with_capacity(corpus.takes.len());
     for t in &corpus.takes {
         let dt = t.motion.frame_time;
         let segs: Vec<(f64, f64)> = t
@@ -143,6 +221,22 @@ pub fn cv_split(
         } else {
             (f64::NAN, f64::NAN, f64::NAN, f64::NAN)
         };
+        parts.push((t, segs, lo, hi, plo, phi));
+    }
+    let trained = |segs: &[(f64, f64)], y: &[[f64; 6]], plo: f64, phi: f64| -> Vec<[f64; 6]> {
+        segs.iter()
+            .zip(y)
+            .filter(|(g, _)| !(g.0 < phi && g.1 > plo))
+            .map(|(_, y)| *y)
+            .collect()
+    };
+    let all: Vec<[f64; 6]> = parts
+        .iter()
+        .flat_map(|(t, segs, _, _, plo, phi)| trained(segs, &t.motion.y_raw, *plo, *phi))
+        .collect();
+    let pooled = level_of(&all, Normalization::identity());
+    for (t, segs, lo, hi, plo, phi) in parts {
+        let level = level_of(&trained(&segs, &t.motion.y_raw, plo, phi), pooled);
         let is_held = |a: f64, b: f64| {
             let mid = 0.5 * (a + b);
             mid >= lo && mid < hi
@@ -151,6 +245,7 @@ pub fn cv_split(
         let empty = || Sequence {
             stem: t.stem.clone(),
             segments: segs.clone(),
+            level,
             ..Sequence::default()
         };
         let (mut before, mut after, mut test) = (empty(), empty(), empty());
@@ -166,12 +261,12 @@ pub fn cv_split(
                 &mut before
             };
             into.features.push(a.features);
-            into.y_raw.push(a.y_raw);
+            into.y_raw.push(level.apply(&a.y_raw));
             into.times.push((t0, t1));
         }
         for (&(g0, g1), y) in segs.iter().zip(&t.motion.y_raw) {
             if !is_purged(g0, g1) {
-                out.segments.push(*y);
+                out.segments.push(level.apply(y));
             }
         }
         out.train
@@ -508,6 +603,27 @@ pub fn fit_crf(
     Ok(crf)
 }
 
+/// The training takes' typical level: their levels' means and spreads averaged, each
+/// sequence weighted by its steps.
+fn typical_level(seqs: &[Sequence]) -> Normalization {
+    let steps: f64 = seqs.iter().map(|s| s.len() as f64).sum();
+    if steps <= 0.0 {
+        return Normalization::identity();
+    }
+    let avg = |f: &dyn Fn(&Normalization) -> [f64; 6]| -> [f64; 6] {
+        std::array::from_fn(|d| {
+            seqs.iter()
+                .map(|s| f(&s.level)[d] * s.len() as f64)
+                .sum::<f64>()
+                / steps
+        })
+    };
+    Normalization {
+        mean: avg(&|n| n.mean),
+        scale: avg(&|n| n.scale),
+    }
+}
+
 /// Fits the whole inference layer, choosing what `cfg` leaves open by held-out likelihood
 /// ([`super::select`]). `log` receives progress lines.
 pub fn fit(
@@ -544,6 +660,7 @@ pub fn fit(
                 ..cfg.prosody
             },
             normalization: base.normalization,
+            take_level: Some(typical_level(seqs)),
             hmm: base.hmm,
             gmm: base.gmm,
             crf,

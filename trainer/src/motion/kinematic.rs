@@ -336,6 +336,14 @@ impl Normalization {
         Ok(Normalization { mean, scale })
     }
 
+    /// The map that applies `self`, then `next`, as one normalization.
+    pub fn then(&self, next: &Normalization) -> Normalization {
+        Normalization {
+            mean: std::array::from_fn(|d| self.mean[d] + self.scale[d] * next.mean[d]),
+            scale: std::array::from_fn(|d| self.scale[d] * next.scale[d]),
+        }
+    }
+
     /// `(y - mean) / scale`.
     pub fn apply(&self, y: &[f64; 6]) -> [f64; 6] {
         std::array::from_fn(|d| (y[d] - self.mean[d]) / self.scale[d])

@@ -45,7 +45,9 @@ use crate::control::Library;
 use crate::corpus::discover;
 use crate::inference::model::{InferenceModel, ModelError};
 use crate::motion::fk::Target;
-use crate::motion::{analyze, read_bvh, EffectorSpec, Motion, SegmentParams, Skeleton};
+use crate::motion::{
+    analyze, read_bvh, EffectorSpec, Motion, Normalization, SegmentParams, Skeleton,
+};
 use crate::output::{write_atomic, OutputError};
 use crate::rig::{Rig, RigError};
 use assemble::{encode_with, labels_section, parts, policy_section, styles_section};
@@ -353,13 +355,20 @@ pub fn pack_model(
     if files.is_empty() {
         return Err(PackError::NoBvh);
     }
+    // Segmented with no normalization first: the library's own level is part of its
+    // normalization (`InferenceModel::library_normalization`).
     let mut lib = Library::from_files(
         &files,
-        &model.normalization,
+        &Normalization::identity(),
         &opts.effectors,
         &SegmentParams::default(),
         3,
     )?;
+    let raw: Vec<[f64; 6]> = lib.segments.iter().map(|s| s.y).collect();
+    let norm = model.library_normalization(&raw);
+    for s in &mut lib.segments {
+        s.y = norm.apply(&s.y);
+    }
     let rig = match &opts.rig {
         Some(p) => Rig::load(p)?,
         None => Rig::full_skeleton(lib.takes[0].motion.skeleton())?,
@@ -386,7 +395,7 @@ pub fn pack_model(
     };
     let (parts, frames) = parts(model, &lib, &rig, opts, labelling.as_ref())?;
     progress.set_message("pack: fitting the tones");
-    let tones = tone_transforms(model, &opts.styles, &opts.effectors)?;
+    let tones = tone_transforms(&norm, &opts.styles, &opts.effectors)?;
     let load_s = start.elapsed().as_secs_f64();
 
     progress.set_message("pack: value iteration and pruning");
@@ -456,7 +465,7 @@ pub fn pack_model(
             Ok(ToneReport {
                 name: t.transform.name.clone(),
                 segments: t.transform.segments,
-                factors: t.transform.factors(&model.normalization),
+                factors: t.transform.factors(&norm),
                 regret: r.regret,
                 agreement: r.agreement,
                 // Two i16 per segment and exit point per state.
@@ -535,9 +544,9 @@ pub fn pack_model(
     })
 }
 
-/// Normalized kinematic vectors of every segment of the BVH files `files`.
+/// Kinematic vectors of every segment of the BVH files `files`, normalized by `norm`.
 fn segment_vectors(
-    model: &InferenceModel,
+    norm: &Normalization,
     files: &[PathBuf],
     effectors: &EffectorSpec,
 ) -> Result<Vec<[f64; 6]>, PackError> {
@@ -546,14 +555,15 @@ fn segment_vectors(
         let motion = read_bvh(f).map_err(LibraryError::from)?;
         let analysis = analyze(&motion, effectors, &SegmentParams::default())
             .map_err(|e| LibraryError::Analysis(format!("{}: {e}", f.display())))?;
-        ys.extend(analysis.y_raw.iter().map(|y| model.normalization.apply(y)));
+        ys.extend(analysis.y_raw.iter().map(|y| norm.apply(y)));
     }
     Ok(ys)
 }
 
-/// The tones' transforms: fitted from motion, then the energy knob's (see [`StyleOptions`]).
+/// The tones' transforms, in the library's normalization `norm`: fitted from motion, then the
+/// energy knob's (see [`StyleOptions`]).
 pub fn tone_transforms(
-    model: &InferenceModel,
+    norm: &Normalization,
     st: &StyleOptions,
     effectors: &EffectorSpec,
 ) -> Result<Vec<ToneTransform>, PackError> {
@@ -564,9 +574,9 @@ pub fn tone_transforms(
                 "--style needs neutral motion to compare with: give --style-neutral FILES".into(),
             ));
         }
-        let neutral = segment_vectors(model, &st.neutral, effectors)?;
+        let neutral = segment_vectors(norm, &st.neutral, effectors)?;
         for (name, files) in &st.tones {
-            let ys = segment_vectors(model, files, effectors)?;
+            let ys = segment_vectors(norm, files, effectors)?;
             out.push(ToneTransform::fit(name, &neutral, &ys)?);
         }
     }
@@ -584,7 +594,7 @@ pub fn tone_transforms(
                 "--style {n}: the name is taken by the --energy knob's tones"
             )));
         }
-        out.extend(ToneTransform::energy(f, &model.normalization));
+        out.extend(ToneTransform::energy(f, norm));
     }
     if out.len() > gesture_runtime::policy::MAX_TONES {
         return Err(PackError::Style(format!(
