@@ -199,14 +199,22 @@ pub fn parse_args<T: Parser>(bin: &str) -> Result<T, std::process::ExitCode> {
     })
 }
 
-/// The first line of a clap message without its `error: ` prefix, pointing to `--help`.
+/// The first line of a clap message without its `error: ` prefix, pointing to `--help`; a
+/// line that ends in a colon takes the items listed under it (the missing arguments).
 fn one_line(rendered: &str) -> String {
-    let first = rendered
-        .lines()
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or("");
-    let first = first.strip_prefix("error: ").unwrap_or(first);
-    format!("{first} (see --help)")
+    let mut lines = rendered.lines().skip_while(|l| l.trim().is_empty());
+    let first = lines.next().unwrap_or("");
+    let mut out = first.strip_prefix("error: ").unwrap_or(first).to_string();
+    if out.ends_with(':') {
+        let items: Vec<&str> = lines
+            .take_while(|l| !l.trim().is_empty())
+            .map(str::trim)
+            .collect();
+        if !items.is_empty() {
+            out = format!("{out} {}", items.join(", "));
+        }
+    }
+    format!("{out} (see --help)")
 }
 
 /// Runs a parsed command line.
@@ -227,4 +235,36 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
 pub(crate) fn ensure_dir(dir: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(dir)
         .map_err(|e| CliError::Input(format!("{}: cannot create folder: {e}", dir.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bad_command_line_is_one_line_that_names_what_is_missing() {
+        #[derive(Parser, Debug)]
+        struct Args {
+            #[arg(long)]
+            train: String,
+            #[arg(long, required_unless_present = "folds")]
+            test: Option<String>,
+            #[arg(long)]
+            folds: Option<usize>,
+        }
+        let e = Args::try_parse_from(["x", "--train", "a"]).unwrap_err();
+        let line = one_line(&e.render().to_string());
+        assert_eq!(
+            line,
+            "the following required arguments were not provided: --test <TEST> (see --help)"
+        );
+        let e = Args::try_parse_from(["x", "--train", "a", "--folds", "two"]).unwrap_err();
+        let line = one_line(&e.render().to_string());
+        assert!(
+            line.starts_with("invalid value 'two' for '--folds <FOLDS>'")
+                && line.ends_with("(see --help)")
+                && !line.contains('\n'),
+            "{line}"
+        );
+    }
 }
