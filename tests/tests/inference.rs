@@ -227,6 +227,10 @@ fn model_file_round_trips_and_refuses_other_versions() {
     let mut old = serde_json::to_value(model.to_file()).unwrap();
     old.as_object_mut().unwrap().remove("take_level");
     std::fs::write(&path, old.to_string()).unwrap();
+    let err = InferenceModel::load(&path).unwrap_err().to_string();
+    assert!(err.contains("take_level"), "{err}");
+    old["version"] = 2.into();
+    std::fs::write(&path, old.to_string()).unwrap();
     let back = InferenceModel::load(&path).unwrap();
     assert_eq!(back.take_level, None);
     let raw = [[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]; 10];

@@ -24,7 +24,14 @@ pub const FORMAT: &str = "gesture-inference-model";
 /// units (limb lengths, height above the shoulder, derivatives over 1/30 s;
 /// [`crate::motion::body`]); version 1 measured them in skeleton units with heights above the
 /// floor, so its normalization and state Gaussians do not apply to today's kinematics.
-pub const VERSION: u32 = 2;
+/// Version 3 standardizes each training take by its own level and records the training
+/// takes' typical level (`take_level`, required); version 2 files, without it, are still
+/// read (their libraries are normalized as they were). An older build refuses a version 3
+/// file rather than pack a library in the wrong terms.
+pub const VERSION: u32 = 3;
+
+/// The oldest version this build reads.
+pub const OLDEST_VERSION: u32 = 2;
 
 /// Why a model file of another version cannot be used.
 pub fn version_reason(found: u32) -> &'static str {
@@ -264,7 +271,7 @@ pub enum ModelError {
         reason: String,
     },
     /// Another version.
-    #[error("{path}: model format version {found}, this build reads version {VERSION} ({reason}): retrain with `gesture-train fit`")]
+    #[error("{path}: model format version {found}, this build reads versions {OLDEST_VERSION} to {VERSION} ({reason}): retrain with `gesture-train fit`")]
     Version {
         /// The file.
         path: String,
@@ -350,12 +357,25 @@ impl InferenceModel {
         if f.format != FORMAT {
             return Err(bad(format!("format tag `{}`", f.format)));
         }
-        if f.version != VERSION {
+        if !(OLDEST_VERSION..=VERSION).contains(&f.version) {
             return Err(ModelError::Version {
                 path: path.into(),
                 found: f.version,
                 reason: version_reason(f.version),
             });
+        }
+        // Version 3 standardizes per take and must say by what; version 2 did not.
+        let take_level = match (f.version, f.take_level) {
+            (2, _) => None,
+            (_, Some(level)) => Some(level),
+            (_, None) => return Err(bad("no take_level (version 3 records it)".into())),
+        };
+        if let Some(level) = take_level {
+            if !level.mean.iter().chain(&level.scale).all(|v| v.is_finite())
+                || level.scale.iter().any(|&v| v <= 0.0)
+            {
+                return Err(bad("take_level is not finite and positive".into()));
+            }
         }
         let prosody = f.front_end.config();
         prosody
@@ -406,7 +426,7 @@ impl InferenceModel {
             sample_rate_hz: prosody.sample_rate_hz,
             prosody,
             normalization: f.normalization,
-            take_level: f.take_level,
+            take_level,
             hmm: Hmm {
                 init: f.hmm.init,
                 trans: f.hmm.trans,
