@@ -28,10 +28,11 @@
 //! no translation): the hands of a speaker who walks or sways move faster in the world than
 //! any played motion can, since a blob holds rotations only (the 067 take's root moves at a
 //! median 8.5 cm/s; with it, its reference for beat-scott put 6.6 % of the frames below
-//! 10 cm/s, as shown 11.9 %). The library's whole capture, the reference before, rewarded playing the library's own mix of rest and motion
-//! whatever the speech: the 9-joint ZeroEGGS take rests through long pauses (a third of its
-//! frames below 10 cm/s) that a monologue does not have, so uniformly random choices were
-//! closest to it and a controller that gestures while the speaker talks was furthest.
+//! 10 cm/s, as shown 11.9 %). The library's whole capture, the reference before, rewarded
+//! playing the library's own mix of rest and motion whatever the speech: the 9-joint
+//! ZeroEGGS take rests through long pauses (a third of its frames below 10 cm/s) that a
+//! monologue does not have, so uniformly random choices were closest to it and a controller
+//! that gestures while the speaker talks was furthest.
 //!
 //! **Regret of variety.** For every decision of the online run, the float, unpruned policy's
 //! expected cost of the choice made is compared with the best choice under the same belief

@@ -282,9 +282,19 @@ pub enum ModelError {
     },
 }
 
-/// Fewest segments a library needs to be standardized by its own level; a smaller one takes
-/// the model's training level.
+/// Fewest segments a take or library needs to be standardized by its own level; a smaller
+/// one takes a fallback level.
 pub const MIN_LEVEL_SEGMENTS: usize = 8;
+
+/// The level of a take or library from the log kinematic parameters `raw` of its segments:
+/// their mean and spread, or `fallback` with fewer than [`MIN_LEVEL_SEGMENTS`] of them.
+pub fn level_of(raw: &[[f64; 6]], fallback: Normalization) -> Normalization {
+    if raw.len() >= MIN_LEVEL_SEGMENTS {
+        Normalization::fit(raw).unwrap_or(fallback)
+    } else {
+        fallback
+    }
+}
 
 impl InferenceModel {
     /// Number of hidden states.
@@ -300,14 +310,7 @@ impl InferenceModel {
     pub fn library_normalization(&self, raw: &[[f64; 6]]) -> Normalization {
         match &self.take_level {
             None => self.normalization,
-            Some(reference) => {
-                let level = if raw.len() >= MIN_LEVEL_SEGMENTS {
-                    Normalization::fit(raw).unwrap_or(*reference)
-                } else {
-                    *reference
-                };
-                level.then(&self.normalization)
-            }
+            Some(reference) => level_of(raw, *reference).then(&self.normalization),
         }
     }
 
@@ -315,7 +318,12 @@ impl InferenceModel {
     pub fn to_file(&self) -> ModelFile {
         ModelFile {
             format: FORMAT.into(),
-            version: VERSION,
+            // A model read from a version 2 file (no take level) is written as one.
+            version: if self.take_level.is_some() {
+                VERSION
+            } else {
+                OLDEST_VERSION
+            },
             front_end: FrontEndFile::from(&self.prosody),
             normalization: self.normalization,
             take_level: self.take_level,

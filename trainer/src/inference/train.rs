@@ -11,7 +11,7 @@ use gesture_runtime::inference::StepFeatures;
 use super::crf::{Crf, CrfConfig, TrainSeq};
 use super::gmm::{Gmm, GmmConfig, ProsodyPoint};
 use super::hmm::{Hmm, HmmConfig, HmmError, Seq};
-use super::model::{InferenceModel, MIN_LEVEL_SEGMENTS};
+use super::model::{level_of, InferenceModel};
 use super::select::{self, Selection};
 use crate::corpus::Corpus;
 use crate::motion::Normalization;
@@ -60,14 +60,9 @@ impl Sequence {
     }
 }
 
-/// A take's level from the log kinematic parameters `raw` of its segments: their mean and
-/// spread, or `fallback` with fewer than [`MIN_LEVEL_SEGMENTS`] of them.
-fn level_of(raw: &[[f64; 6]], fallback: Normalization) -> Normalization {
-    if raw.len() >= MIN_LEVEL_SEGMENTS {
-        Normalization::fit(raw).unwrap_or(fallback)
-    } else {
-        fallback
-    }
+/// Whether the span `a..b` overlaps `lo..hi` (false when either bound is NaN).
+fn overlaps(a: f64, b: f64, lo: f64, hi: f64) -> bool {
+    a < hi && b > lo
 }
 
 /// The segments of a take inside `span` (by midpoint): `(start_s, end_s, raw vector)`.
@@ -127,7 +122,11 @@ pub fn sequences_with_levels(
     span: Option<(f64, f64)>,
     levels: &HashMap<String, Normalization>,
 ) -> (Vec<Sequence>, Vec<[f64; 6]>) {
-    let own = take_levels(corpus, span);
+    let own = if corpus.takes.iter().all(|t| levels.contains_key(&t.stem)) {
+        HashMap::new()
+    } else {
+        take_levels(corpus, span)
+    };
     let inside = in_span(span);
     let mut seqs = Vec::new();
     let mut segs = Vec::new();
@@ -193,13 +192,7 @@ pub fn cv_split(
     // own kinematics are not looked at); a take with too few, by all training segments'.
     let mut parts = Vec::with_capacity(corpus.takes.len());
     for t in &corpus.takes {
-        let dt = t.motion.frame_time;
-        let segs: Vec<(f64, f64)> = t
-            .motion
-            .segments
-            .iter()
-            .map(|g| (g.start_frame as f64 * dt, g.end_frame as f64 * dt))
-            .collect();
+        let segs = take_segments(t, |_, _| true);
         let (lo, hi, plo, phi) = if held(&t.stem) {
             let len = t.motion_s();
             // The last span takes whatever lies past the motion's end too (audio a little
@@ -211,8 +204,8 @@ pub fn cv_split(
             };
             let lo = len * fold as f64 / folds as f64;
             let (mut plo, mut phi) = (lo, hi);
-            for &(g0, g1) in &segs {
-                if g0 < hi && g1 > lo {
+            for &(g0, g1, _) in &segs {
+                if overlaps(g0, g1, lo, hi) {
                     plo = plo.min(g0);
                     phi = phi.max(g1);
                 }
@@ -223,28 +216,29 @@ pub fn cv_split(
         };
         parts.push((t, segs, lo, hi, plo, phi));
     }
-    let trained = |segs: &[(f64, f64)], y: &[[f64; 6]], plo: f64, phi: f64| -> Vec<[f64; 6]> {
+    // The segments left for training, as raw vectors.
+    let trained = |segs: &[(f64, f64, [f64; 6])], plo: f64, phi: f64| -> Vec<[f64; 6]> {
         segs.iter()
-            .zip(y)
-            .filter(|(g, _)| !(g.0 < phi && g.1 > plo))
-            .map(|(_, y)| *y)
+            .filter(|g| !overlaps(g.0, g.1, plo, phi))
+            .map(|g| g.2)
             .collect()
     };
     let all: Vec<[f64; 6]> = parts
         .iter()
-        .flat_map(|(t, segs, _, _, plo, phi)| trained(segs, &t.motion.y_raw, *plo, *phi))
+        .flat_map(|(_, segs, _, _, plo, phi)| trained(segs, *plo, *phi))
         .collect();
     let pooled = level_of(&all, Normalization::identity());
     for (t, segs, lo, hi, plo, phi) in parts {
-        let level = level_of(&trained(&segs, &t.motion.y_raw, plo, phi), pooled);
+        let train_segs = trained(&segs, plo, phi);
+        let level = level_of(&train_segs, pooled);
         let is_held = |a: f64, b: f64| {
             let mid = 0.5 * (a + b);
             mid >= lo && mid < hi
         };
-        let is_purged = |a: f64, b: f64| a < phi && b > plo;
+        let times: Vec<(f64, f64)> = segs.iter().map(|g| (g.0, g.1)).collect();
         let empty = || Sequence {
             stem: t.stem.clone(),
-            segments: segs.clone(),
+            segments: times.clone(),
             level,
             ..Sequence::default()
         };
@@ -253,7 +247,7 @@ pub fn cv_split(
             let (t0, t1) = (a.step.start_s(), a.step.end_s());
             let into = if is_held(t0, t1) {
                 &mut test
-            } else if is_purged(t0, t1) {
+            } else if overlaps(t0, t1, plo, phi) {
                 continue;
             } else if t0 >= phi {
                 &mut after
@@ -264,11 +258,8 @@ pub fn cv_split(
             into.y_raw.push(level.apply(&a.y_raw));
             into.times.push((t0, t1));
         }
-        for (&(g0, g1), y) in segs.iter().zip(&t.motion.y_raw) {
-            if !is_purged(g0, g1) {
-                out.segments.push(level.apply(y));
-            }
-        }
+        out.segments
+            .extend(train_segs.iter().map(|y| level.apply(y)));
         out.train
             .extend([before, after].into_iter().filter(|s| !s.is_empty()));
         if !test.is_empty() {
