@@ -24,6 +24,16 @@
 //! decides at every exit point as soon as it is reached (the paper's controller). Onsets come
 //! from the front-end ([`Event::Onset`]).
 //!
+//! **Cuts between strokes** (`defer_cut_ms`, 400 ms by default). A cut decided while the
+//! playing segment is in the middle (not at its last frame) waits until that segment shows a
+//! pause of the hands, a motion beat or a calm frame ([`LibraryFrames::is_beat`],
+//! [`LibraryFrames::is_calm`]) or its last frame, for at most `defer_cut_ms`; the segment
+//! plays on meanwhile and no exit point is considered. The decision, its belief and its event
+//! stay at the onset; the entry (history, next exit point) counts from the cut. Cutting in the
+//! middle of a stroke shows no jump (the blend keeps pose and velocity), but the hands leave at
+//! the speed they had; between strokes they are slow. A decision while a semantic label waits
+//! cuts at once.
+//!
 //! **Beat holds** (`beat_hold_ms`, 0 by default): at a motion beat of the library (a hands'
 //! speed minimum) the playback may hold, for at most that long, until a syllable onset.
 //!
@@ -131,16 +141,21 @@ pub struct DecisionTiming {
     pub max_wait_ms: u32,
     /// Longest hold (ms) at a motion beat waiting for an onset (0: no holds).
     pub beat_hold_ms: u32,
+    /// Longest delay (ms) of a cut decided mid-segment until the hands pause (a motion beat
+    /// of the playing segment; 0: cut at once).
+    pub defer_cut_ms: u32,
 }
 
 impl DecisionTiming {
-    /// Decisions on onsets: an onset within 50 ms, a hold of at most 300 ms at segment ends
-    /// (chosen on held-out speech with `gesture-train eval-motion`; see the README).
+    /// Decisions on onsets: an onset within 50 ms, a hold of at most 300 ms at segment ends, a
+    /// cut decided mid-segment put off for at most 400 ms until the hands pause (chosen on
+    /// tuning speech with `gesture-train eval-motion`; see docs/method.md).
     pub const DEFAULT: Self = Self {
         sync_to_onsets: true,
         onset_window_ms: 50,
         max_wait_ms: 300,
         beat_hold_ms: 0,
+        defer_cut_ms: 400,
     };
     /// Every exit point decides as soon as it is reached.
     pub const IMMEDIATE: Self = Self {
@@ -148,6 +163,7 @@ impl DecisionTiming {
         onset_window_ms: 0,
         max_wait_ms: 0,
         beat_hold_ms: 0,
+        defer_cut_ms: 0,
     };
 }
 
@@ -305,6 +321,8 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     waiting: Option<usize>,
     /// Ticks waited at it.
     waited: u64,
+    /// A cut decided and waiting for the hands to pause: segment, entry frame, ticks waited.
+    deferred: Option<(usize, usize, u64)>,
 }
 
 impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
@@ -364,6 +382,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             last_onset: None,
             waiting: None,
             waited: 0,
+            deferred: None,
         });
         if let Err(e) = me.front_end.configure(config) {
             *slot = None;
@@ -714,6 +733,16 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         });
         self.labels_after_tick(tick, segment, played, sink);
         let t = self.timing;
+        if let Some((c, f, waited)) = self.deferred {
+            if self.hands_pause(segment, played) || self.ticks_reach_ms(waited + 1, t.defer_cut_ms)
+            {
+                self.deferred = None;
+                self.cut(c, f, tick);
+            } else {
+                self.deferred = Some((c, f, waited + 1));
+            }
+            return;
+        }
         // A waiting label decides at the next exit point, onset or not.
         let fresh = !t.sync_to_onsets
             || self.label_waiting()
@@ -788,6 +817,35 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         self.decide(e, tick, sink);
     }
 
+    /// Whether frame `f` of segment `c` is a pause of the hands where a deferred cut may
+    /// fall: a motion beat, a calm frame or the segment's last frame.
+    fn hands_pause(&self, c: usize, f: usize) -> bool {
+        self.lib.is_beat(c, f) || self.lib.is_calm(c, f) || f + 1 >= self.lib.segment_len(c)
+    }
+
+    /// Cuts to segment `c` at frame `f` now.
+    fn cut(&mut self, c: usize, f: usize, tick: u64) {
+        self.player.enter_at(self.lib, c, f);
+        self.record_entry(c, tick.min(u32::MAX as u64) as u32);
+    }
+
+    /// Remembers entering `c` at tick `now` and finds its first exit point not yet passed.
+    fn record_entry(&mut self, c: usize, now: u32) {
+        self.history.write(Visit {
+            segment: c.min(u16::MAX as usize) as u16,
+            tick: now,
+        });
+        let mut x = self.tables.first_exit(c);
+        let frame = self.player.frame();
+        while !self.tables.exit_is_end(x)
+            && self.tables.exit_frame(x) < frame
+            && x + 1 < self.tables.exit_count()
+        {
+            x += 1;
+        }
+        self.exit = x;
+    }
+
     /// Decides at exit `e` and acts on it.
     fn decide(&mut self, e: usize, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
         let now = tick.min(u32::MAX as u64) as u32;
@@ -818,9 +876,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                 // The player ran on into the recorded successor while waiting: choosing it
                 // goes on without a cut; anything else (or no run-on) is a cut.
                 let ran_on = self.player.segment() != self.tables.exit_segment(e);
-                if !(ran_on && c == self.player.segment() && decision.entry_frame == 0) {
-                    self.player.enter_at(self.lib, c, decision.entry_frame);
-                }
+                let seamless = ran_on && c == self.player.segment() && decision.entry_frame == 0;
                 if let Some(mut a) = waiting {
                     if self.tables.label_of(c) == a.label + 1 {
                         if let Some(stroke) = self.tables.stroke_of(c) {
@@ -837,20 +893,23 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                         }
                     }
                 }
-                self.history.write(Visit {
-                    segment: c.min(u16::MAX as usize) as u16,
-                    tick: now,
-                });
-                // The first exit point not yet passed.
-                let mut x = self.tables.first_exit(c);
-                let frame = self.player.frame();
-                while !self.tables.exit_is_end(x)
-                    && self.tables.exit_frame(x) < frame
-                    && x + 1 < self.tables.exit_count()
-                {
-                    x += 1;
+                // The frame just shown (the player has moved past it unless it holds the last).
+                let shown = if self.player.at_end(self.lib) {
+                    self.player.frame()
+                } else {
+                    self.player.frame().saturating_sub(1)
+                };
+                let defer = !seamless
+                    && waiting.is_none()
+                    && self.timing.defer_cut_ms > 0
+                    && !self.hands_pause(self.player.segment(), shown);
+                if defer {
+                    self.deferred = Some((c, decision.entry_frame, 0));
+                } else if seamless {
+                    self.record_entry(c, now);
+                } else {
+                    self.cut(c, decision.entry_frame, tick);
                 }
-                self.exit = x;
             }
         }
         sink(ControllerEvent::Decision { tick, decision });

@@ -119,6 +119,10 @@ pub trait LibraryFrames {
     fn is_beat(&self, _c: usize, _f: usize) -> bool {
         false
     }
+    /// Whether frame `f` of segment `c` is calm (the hands slow).
+    fn is_calm(&self, _c: usize, _f: usize) -> bool {
+        false
+    }
     /// Rotation groups (three channels holding one rotation as Euler angles).
     fn group_count(&self) -> usize {
         0

@@ -305,6 +305,14 @@ fn every_error_variant_is_reachable() {
         },
     );
     check(
+        &mutated(&|t| t.calm = vec![0, 0]),
+        BlobError::TableLength {
+            field: Field::Calm,
+            expected: 1,
+            found: 2,
+        },
+    );
+    check(
         &mutated(&|t| t.groups = vec![0, 0]),
         BlobError::TableLength {
             field: Field::Groups,
@@ -504,6 +512,12 @@ fn every_error_variant_is_reachable() {
         &mutated(&|t| t.control.beat_hold_ms = 1001),
         BlobError::BadControl {
             field: Field::BeatHold,
+        },
+    );
+    check(
+        &mutated(&|t| t.control.defer_cut_ms = 1001),
+        BlobError::BadControl {
+            field: Field::DeferCut,
         },
     );
 

@@ -112,16 +112,17 @@ fn golden_bytes_and_round_trip() {
     );
     assert_eq!(blob.successors(3).len(), 0);
     // control
-    assert_eq!(sz.control, 21);
+    assert_eq!(sz.control, 23);
     let t = blob.timing();
     assert_eq!(
         (
             t.sync_to_onsets,
             t.onset_window_ms,
             t.max_wait_ms,
-            t.beat_hold_ms
+            t.beat_hold_ms,
+            t.defer_cut_ms
         ),
-        (true, 50, 300, 150)
+        (true, 50, 300, 150, 200)
     );
     let v = blob.variety();
     assert_eq!(
@@ -146,6 +147,8 @@ fn golden_bytes_and_round_trip() {
     assert!(blob.continues(0) && !blob.continues(1) && !blob.continues(2));
     let beats: Vec<usize> = (0..8).filter(|&f| blob.is_beat_frame(f)).collect();
     assert_eq!(beats, [1, 4]);
+    let calm: Vec<usize> = (0..8).filter(|&f| blob.is_calm_frame(f)).collect();
+    assert_eq!(calm, [0, 5]);
     assert_eq!((blob.group_count(), blob.group(0)), (0, None));
     assert!((blob.frame(0, 3) - 13.0).abs() < 1e-5);
     assert!((blob.segment_value(1, 2, 0) - 8.0).abs() < 1e-5);

@@ -59,7 +59,9 @@ fn constructors_round_trip_through_the_reader() {
         })
         .collect();
     // Channels 0..3 hold one rotation (Z, Y, X: EULER_ORDERS index 5).
-    let library = OwnedLibrary::new(25.0, 3, &frames, &segs, &[3, 17], &[(0, 5)]).unwrap();
+    let library = OwnedLibrary::new(25.0, 3, &frames, &segs, &[3, 17], &[(0, 5)])
+        .unwrap()
+        .with_calm(&[0, 9, 19, 20]);
     // Exits: an interruption at frame 2 of every segment and the end at frame 4.
     let exits: Vec<(usize, usize)> = (0..4).flat_map(|s| [(s, 2), (s, 4)]).collect();
     // End exits: two successors sorted by segment; interruptions: none.
@@ -98,6 +100,7 @@ fn constructors_round_trip_through_the_reader() {
         onset_window_ms: 0,
         max_wait_ms: 120,
         beat_hold_ms: 90,
+        defer_cut_ms: 70,
     };
     let variety = Variety {
         recency_cost: 1.25,
@@ -139,6 +142,9 @@ fn constructors_round_trip_through_the_reader() {
     assert!(b.continues(0) && b.continues(2) && !b.continues(3));
     let beats: Vec<usize> = (0..20).filter(|&f| b.is_beat_frame(f)).collect();
     assert_eq!(beats, [3, 17]);
+    // Calm frames as given; one past the frame table is dropped.
+    let calm: Vec<usize> = (0..24).filter(|&f| b.is_calm_frame(f)).collect();
+    assert_eq!(calm, [0, 9, 19]);
     assert_eq!((b.group_count(), b.group(0)), (1, Some((0, [2, 1, 0]))));
     // Frames come back within half a quantization step of each channel's range.
     for (f, fr) in frames.iter().enumerate() {

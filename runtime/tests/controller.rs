@@ -52,6 +52,10 @@ impl PolicyTables for Tables {
 
 struct Lib {
     lens: [usize; 3],
+    /// Every `beat_every`-th frame (from frame `beat_every - 1`) is a motion beat (0: none).
+    beat_every: usize,
+    /// Frames 2, 8, 14, ... are calm.
+    calm: bool,
 }
 
 impl LibraryFrames for Lib {
@@ -73,6 +77,12 @@ impl LibraryFrames for Lib {
     /// Segment 1 is segment 0's recorded successor, 2 is 1's; 2 ends a clip.
     fn continues(&self, c: usize) -> bool {
         c < 2
+    }
+    fn is_beat(&self, _c: usize, f: usize) -> bool {
+        self.beat_every > 0 && f % self.beat_every == self.beat_every - 1
+    }
+    fn is_calm(&self, _c: usize, f: usize) -> bool {
+        self.calm && f % 6 == 2
     }
 }
 
@@ -129,6 +139,8 @@ enum Rec {
     Step(u32, Vec<f32>),
     /// An onset (its frame) reported before the pose of this tick.
     Onset(u64, u32),
+    /// The library segment and frame a tick showed.
+    Shown(u64, usize, usize),
 }
 
 fn run(audio: &[i16], chunk: usize) -> Vec<Rec> {
@@ -151,8 +163,28 @@ fn run_varied(
     variety: Variety,
     held: Option<&[f32]>,
 ) -> Vec<Rec> {
+    let lib = Lib {
+        lens: [20, 12, 30],
+        beat_every: 0,
+        calm: false,
+    };
+    run_on(&lib, audio, chunk, finish, timing, variety, held, false)
+}
+
+/// A run over `lib`; with `shown`, each pose is followed by what it showed
+/// ([`Rec::Shown`]).
+#[allow(clippy::too_many_arguments)]
+fn run_on(
+    lib: &Lib,
+    audio: &[i16],
+    chunk: usize,
+    finish: bool,
+    timing: DecisionTiming,
+    variety: Variety,
+    held: Option<&[f32]>,
+    shown: bool,
+) -> Vec<Rec> {
     let t = tables();
-    let lib = Lib { lens: [20, 12, 30] };
     let crf_bytes_init = [0u8; 4];
     let mut trans = Vec::new();
     for v in [400i16, -400, -400, 400] {
@@ -172,7 +204,7 @@ fn run_varied(
     )
     .unwrap();
     let g = gmm();
-    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &lib).unwrap();
+    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, lib).unwrap();
     assert_eq!(c.timing(), DecisionTiming::DEFAULT);
     c.set_timing(timing);
     c.set_variety(variety);
@@ -183,9 +215,17 @@ fn run_varied(
         ControllerEvent::Decision { tick, decision } => {
             out.push(Rec::Decision(tick, decision.exit, decision.choice))
         }
-        ControllerEvent::Pose { tick, pose, .. } => {
+        ControllerEvent::Pose {
+            tick,
+            pose,
+            segment,
+            frame,
+        } => {
             next_tick = tick + 1;
-            out.push(Rec::Pose(tick, pose.to_vec()))
+            out.push(Rec::Pose(tick, pose.to_vec()));
+            if shown {
+                out.push(Rec::Shown(tick, segment, frame));
+            }
         }
         ControllerEvent::Step { step, belief } => {
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
@@ -298,7 +338,7 @@ fn garbage_audio_keeps_producing_valid_poses() {
                 assert!((s - 1.0).abs() < 1e-4 && b.iter().all(|v| v.is_finite()));
             }
             Rec::Decision(_, e, _) => assert!(e < 5),
-            Rec::Onset(..) => {}
+            Rec::Onset(..) | Rec::Shown(..) => {}
         }
     }
 }
@@ -306,7 +346,11 @@ fn garbage_audio_keeps_producing_valid_poses() {
 #[test]
 fn new_in_builds_in_place_what_new_builds() {
     let t = tables();
-    let lib = Lib { lens: [20, 12, 30] };
+    let lib = Lib {
+        lens: [20, 12, 30],
+        beat_every: 0,
+        calm: false,
+    };
     let init = [0u8; 4];
     let mut trans = Vec::new();
     for v in [400i16, -400, -400, 400] {
@@ -592,4 +636,118 @@ fn an_interruption_exit_stays_armed_for_an_onset_within_the_longest_wait() {
         }
     }
     assert!(armed > 0, "no interruption exit decided after its frame");
+}
+
+/// Ticks of 400 ms at 30 fps: the default longest delay of a cut.
+const DEFER_TICKS: u64 = 12;
+
+/// Per tick from 0, the (segment, frame) shown.
+fn shown(recs: &[Rec]) -> Vec<(usize, usize)> {
+    recs.iter()
+        .filter_map(|r| match *r {
+            Rec::Shown(_, s, f) => Some((s, f)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// For each cut decided at tick `t` (an entry, but not a choice of the recorded successor
+/// the player ran on into): the decided exit, `t`, and the first tick after `t` that does not
+/// show the next frame of the playing segment (the cut), if the run reached it.
+fn cuts(recs: &[Rec]) -> Vec<(usize, u64, Option<u64>)> {
+    let sh = shown(recs);
+    recs.iter()
+        .filter_map(|r| match *r {
+            Rec::Decision(t, e, Choice::Enter(c)) => Some((t, e, c)),
+            _ => None,
+        })
+        .filter(|&(t, e, c)| {
+            let seg = sh[t as usize].0;
+            !(seg != EXITS[e].0 && c == seg)
+        })
+        .map(|(t, e, _)| {
+            let (seg, frame) = sh[t as usize];
+            let cut = (t + 1..sh.len() as u64)
+                .find(|&u| sh[u as usize] != (seg, frame + (u - t) as usize));
+            (e, t, cut)
+        })
+        .collect()
+}
+
+#[test]
+fn a_cut_decided_mid_segment_waits_for_the_hands_to_pause() {
+    let audio = speech(12.0);
+    let run = |beat_every: usize, calm: bool, timing: DecisionTiming| {
+        let lib = Lib {
+            lens: [20, 12, 30],
+            beat_every,
+            calm,
+        };
+        // State 1 held: leaving at interruption exits is cheaper than continuing.
+        let held = [0.0, 1.0];
+        run_on(
+            &lib,
+            &audio,
+            160,
+            false,
+            timing,
+            Variety::NONE,
+            Some(&held),
+            true,
+        )
+    };
+    let at_once = DecisionTiming {
+        defer_cut_ms: 0,
+        ..DecisionTiming::DEFAULT
+    };
+    assert_eq!(DecisionTiming::DEFAULT.defer_cut_ms, 400);
+    // Cut at once: every entry shows on the next tick.
+    let recs = run(5, true, at_once);
+    let c = cuts(&recs);
+    assert!(
+        c.iter().any(|&(e, _, _)| !EXITS[e].2),
+        "no entry at an interruption"
+    );
+    for &(e, t, cut) in &c {
+        assert_eq!(cut, Some(t + 1), "exit {e} at tick {t}");
+    }
+    // Deferred: the cut shows on the tick after the playing segment shows a beat, a calm
+    // frame or its last frame (at once if the decision's tick did), and at most 400 ms after
+    // the decision.
+    for (beat_every, calm) in [(5, false), (0, true), (0, false)] {
+        let recs = run(beat_every, calm, DecisionTiming::DEFAULT);
+        let sh = shown(&recs);
+        let lib = Lib {
+            lens: [20, 12, 30],
+            beat_every,
+            calm,
+        };
+        let (mut deferred, mut by_beat) = (0, 0);
+        for (e, t, cut) in cuts(&recs) {
+            let Some(cut) = cut else { continue };
+            let (seg, _) = sh[t as usize];
+            let pause = (t..=t + DEFER_TICKS).find(|&u| {
+                let f = sh[u as usize].1;
+                lib.is_beat(seg, f) || lib.is_calm(seg, f) || f + 1 == lib.lens[seg]
+            });
+            let want = pause.map_or(t + 1 + DEFER_TICKS, |u| u + 1);
+            assert_eq!(
+                cut, want,
+                "beats every {beat_every}, calm {calm}: exit {e} at tick {t}"
+            );
+            if cut > t + 1 {
+                deferred += 1;
+                by_beat += pause.is_some_and(|u| {
+                    let f = sh[u as usize].1;
+                    lib.is_beat(seg, f) || lib.is_calm(seg, f)
+                }) as usize;
+            }
+        }
+        assert!(deferred > 0, "beats every {beat_every}: no cut deferred");
+        assert_eq!(
+            by_beat > 0,
+            beat_every > 0 || calm,
+            "beats every {beat_every}"
+        );
+    }
 }

@@ -247,13 +247,12 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
     assert!(online.still_share <= 0.02, "{online:?}");
     // The controller must make cuts (following the recorded order would win on jumps by never
     // cutting), and make them no larger than random ones. The mean jump at a cut is the
-    // hands' speed there (the blend keeps it continuous): the device cuts at interruption
-    // frames, mid-motion, random choices only at segment ends where the hands are slowest,
-    // and across models the two differ by a few percent either way (1.35 to 1.52 cm against
-    // 1.49), so the comparison allows 5 %.
+    // hands' speed there (the blend keeps it continuous); random choices cut only at segment
+    // ends, where the hands are slowest, and the device puts a cut decided mid-segment off
+    // until the hands pause (1.29 cm against 1.49; cutting at once it was 1.35-1.52).
     assert!(online.cuts_per_s > 0.1, "{online:?}");
     assert!(
-        online.jump_at_cuts <= 1.05 * random.jump_at_cuts,
+        online.jump_at_cuts <= random.jump_at_cuts,
         "{online:?} vs {random:?}"
     );
 }
@@ -265,10 +264,10 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
 /// beat-scott more than with random choices and both ablations, on both libraries), long
 /// segments do not take over (half the library or more and no segment above 15 % of two
 /// minutes of another speaker), and no cut jumps more than the capture's own 99th
-/// percentile step.
+/// percentile step, nor on average more than random choices' cuts on beat-scott.
 ///
-/// Not asserted: online against the belief held at the prior. Averaged over the device runs
-/// the prior ablation follows the intensity as well or better (+0.27 against +0.12 here): the
+/// Not asserted on 90-121 s: online against the belief held at the prior. Averaged over the
+/// device runs the prior ablation follows the intensity as well (+0.062 against +0.056): the
 /// coupling comes from deciding on the syllable onsets, which both do, and the belief does
 /// not yet add to it (issue 13); a single run's comparison was a draw.
 #[test]
@@ -333,17 +332,21 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
     assert!(online.library_share.unwrap() >= 0.5, "{online:?}");
     assert!(online.max_segment_share <= 0.15, "{online:?}");
     assert!(online.repeat_5s_share <= 0.10, "{online:?}");
-    // Cuts: none jumps more than the capture's own 99th percentile step. (Not against random
-    // cuts: played by the same player, whose blends slow down for large pose gaps, random's
-    // cuts jump as little, 0.37 against 0.38 cm, both far below the capture's 2.2.)
+    // Cuts: none jumps more than the capture's own 99th percentile step, and on average no
+    // more than random choices' (which cut only at segment ends; the device waits for a pause
+    // of the hands: 0.34 against 0.38 cm).
     assert!(
         online.max_jump_at_cuts <= capture_p99,
         "{online:?} vs the capture's {capture_p99}"
     );
+    assert!(
+        online.jump_at_cuts <= random.jump_at_cuts,
+        "{online:?} vs {random:?}"
+    );
     // The speech matters: the device's hands follow the speech's loudness more than with the
-    // belief held at the prior, on shuffled speech or with random choices (+0.09 against
-    // +0.01, +0.03, -0.04), and its hand speeds are far closer to the capture's in speech
-    // (the speech-matched reference) than random choices' (0.045 against 0.128). Beat
+    // belief held at the prior, on shuffled speech or with random choices (+0.085 against
+    // +0.039, +0.061, -0.005), and its hand speeds are far closer to the capture's in speech
+    // (the speech-matched reference) than random choices' (0.041 against 0.145). Beat
     // alignment is not compared: the methods' means differ by about a hundredth, their
     // runs spread by two or three.
     let coupling = |m: &str| row(&other, m).speech_coupling;
@@ -387,9 +390,9 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
     eprintln!("bandai: online {online:?}");
     assert!(online.max_segment_share <= 0.15, "{online:?}");
     assert!(online.repeat_5s_share <= 0.10, "{online:?}");
-    // The hands follow the speech more than with the prior belief or shuffled speech (+0.15
-    // against +0.07 and -0.02), and their speeds are closer to the library's than random
-    // choices' (0.111 against 0.153; these clips have no speech of their own).
+    // The hands follow the speech more than with the prior belief or shuffled speech (+0.096
+    // against +0.061 and +0.042), and their speeds are closer to the library's than random
+    // choices' (0.150 against 0.158; these clips have no speech of their own).
     let band_row = |m: &str| row(&band, m);
     for ablation in ["online_prior", "online_shuffled"] {
         assert!(

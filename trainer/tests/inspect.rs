@@ -45,12 +45,13 @@ fn summarizes_a_valid_blob() {
     let text = String::from_utf8(out.stdout).unwrap();
     for want in [
         format!(
-            "blob: {n} bytes, format version 5, flags 0x0000, payload {} bytes",
+            "blob: {n} bytes, format version 6, flags 0x0000, payload {} bytes",
             n - 16
         ),
         "sections (bytes): front_end ".to_string(),
         "front_end: 16000 Hz, pitch 75-600 Hz".to_string(),
-        "control: decisions on syllable onsets (within 50 ms; a segment end waits up to 300 ms)"
+        "control: decisions on syllable onsets (within 50 ms; a segment end waits up to 300 ms); \
+         a cut decided mid-segment waits up to 400 ms for the hands to pause"
             .to_string(),
         "variety: recency cost 0 over 0 ms, usage cost 0 over 0 ms; cuts blended over 0 ms; \
          beat hold 0 ms"

@@ -370,8 +370,20 @@ pub struct OwnedLibrary {
     pub continues: Vec<u8>,
     /// Beat bitset over the frame table.
     pub beats: Vec<u8>,
+    /// Calm bitset over the frame table.
+    pub calm: Vec<u8>,
     /// Rotation-group records.
     pub groups: Vec<u8>,
+}
+
+/// A bitset of `frames` bits (bit `f % 8` of byte `f / 8`) with the bits `set` set (those of
+/// no frame ignored, so the padding bits stay 0).
+fn frame_bits(frames: usize, set: &[usize]) -> Vec<u8> {
+    let mut bits = alloc::vec![0u8; frames.div_ceil(8)];
+    for &f in set.iter().filter(|&&f| f < frames) {
+        bits[f / 8] |= 1 << (f % 8);
+    }
+    bits
 }
 
 impl OwnedLibrary {
@@ -390,8 +402,16 @@ impl OwnedLibrary {
             labels: &self.labels,
             continues: &self.continues,
             beats: &self.beats,
+            calm: &self.calm,
             groups: &self.groups,
         }
+    }
+
+    /// The same library with the frames `calm` (indices into the frame table; none by
+    /// default) marked calm (the hands slow: where a deferred cut may fall).
+    pub fn with_calm(mut self, calm: &[usize]) -> Self {
+        self.calm = frame_bits(self.frames as usize, calm);
+        self
     }
 
     /// Quantizes `frames` (one `Vec` of channel values in degrees per frame, all of length
@@ -458,15 +478,8 @@ impl OwnedLibrary {
             strokes,
             labels: segments.iter().map(|s| s.label).collect(),
             continues: segments.iter().map(|s| s.continues as u8).collect(),
-            beats: {
-                let mut bits = alloc::vec![0u8; frames.len().div_ceil(8)];
-                for &f in beats {
-                    if let Some(b) = bits.get_mut(f / 8) {
-                        *b |= 1 << (f % 8);
-                    }
-                }
-                bits
-            },
+            beats: frame_bits(frames.len(), beats),
+            calm: frame_bits(frames.len(), &[]),
             groups: groups
                 .iter()
                 .map(|&(first, order)| {

@@ -97,6 +97,8 @@ pub enum Field {
     Blend,
     /// `control.beat_hold_ms`.
     BeatHold,
+    /// `control.defer_cut_ms`.
+    DeferCut,
     /// `library.channels`.
     Channels,
     /// `library.frames`.
@@ -117,6 +119,8 @@ pub enum Field {
     Continues,
     /// `library.beats`.
     Beats,
+    /// `library.calm`.
+    Calm,
     /// `library.groups`.
     Groups,
     /// `rig.calibration`.
@@ -184,6 +188,7 @@ impl Field {
             Self::Usage => "control.usage_cost",
             Self::Blend => "control.blend_ms",
             Self::BeatHold => "control.beat_hold_ms",
+            Self::DeferCut => "control.defer_cut_ms",
             Self::Channels => "library.channels",
             Self::Frames => "library.frames",
             Self::SegStart => "library.seg_start",
@@ -194,6 +199,7 @@ impl Field {
             Self::Labels => "library.labels",
             Self::Continues => "library.continues",
             Self::Beats => "library.beats",
+            Self::Calm => "library.calm",
             Self::Groups => "library.groups",
             Self::Calibration => "rig.calibration",
             Self::Joints => "skeleton.joints",

@@ -88,3 +88,5 @@ pub const MAX_VARIETY_COST: f32 = 1.0e6;
 pub const MAX_BLEND_MS: u16 = 5000;
 /// Longest hold at a motion beat of the `control` section (ms).
 pub const MAX_BEAT_HOLD_MS: u16 = 1000;
+/// Longest delay of a cut until the hands pause, of the `control` section (ms).
+pub const MAX_DEFER_CUT_MS: u16 = 1000;

@@ -284,6 +284,8 @@ pub struct ControlSection {
     pub blend_ms: u16,
     /// Longest hold at a motion beat waiting for a syllable onset (ms; 0: no holds).
     pub beat_hold_ms: u16,
+    /// Longest delay of a cut decided mid-segment until the hands pause (ms; 0: cut at once).
+    pub defer_cut_ms: u16,
 }
 
 impl ControlSection {
@@ -305,6 +307,7 @@ impl ControlSection {
             usage_ms: ms(v.usage_ms),
             blend_ms: ms(blend_ms),
             beat_hold_ms: ms(t.beat_hold_ms),
+            defer_cut_ms: ms(t.defer_cut_ms),
         }
     }
 }
@@ -346,6 +349,11 @@ pub struct LibrarySection<'a> {
     /// the frames where the hands' speed has a local minimum.
     #[serde(borrow)]
     pub beats: &'a [u8],
+    /// Calm frames: a bit per frame of the frame table (as `beats`), set where the hands'
+    /// smoothed speed is at most the library's 30th percentile. A cut decided mid-segment may
+    /// fall on a calm frame or a beat ([`DecisionTiming::defer_cut_ms`](crate::controller::DecisionTiming::defer_cut_ms)).
+    #[serde(borrow)]
+    pub calm: &'a [u8],
     /// Rotation groups: records `{first: u16, order: u8}`, three channels
     /// `first..first + 3` holding one joint rotation as Euler angles in that order
     /// ([`EULER_ORDERS`](super::EULER_ORDERS) index), blended as rotations; sorted, disjoint.

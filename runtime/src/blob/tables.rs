@@ -110,6 +110,10 @@ impl LibraryFrames for Blob<'_> {
         self.segment(c)
             .is_some_and(|s| f < s.len as usize && self.is_beat_frame(s.start as usize + f))
     }
+    fn is_calm(&self, c: usize, f: usize) -> bool {
+        self.segment(c)
+            .is_some_and(|s| f < s.len as usize && self.is_calm_frame(s.start as usize + f))
+    }
     fn group_count(&self) -> usize {
         Blob::group_count(self)
     }

@@ -9,7 +9,7 @@ use super::payload::*;
 use super::records::{calibration_from_record, f32_at, record, u16_at, u32_at};
 use super::skeleton::{Drive, MAX_JOINTS};
 use super::{
-    MAX_BEAT_HOLD_MS, MAX_BLEND_MS, MAX_CHANNELS, MAX_EXITS, MAX_FPS, MAX_FRAMES,
+    MAX_BEAT_HOLD_MS, MAX_BLEND_MS, MAX_CHANNELS, MAX_DEFER_CUT_MS, MAX_EXITS, MAX_FPS, MAX_FRAMES,
     MAX_ONSET_WINDOW_MS, MAX_SEGMENTS, MAX_VARIETY_COST, MAX_WAIT_MS,
 };
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
@@ -289,6 +289,7 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
     length(Field::Labels, l.labels, segs, 1)?;
     length(Field::Continues, l.continues, segs, 1)?;
     length(Field::Beats, l.beats, frames.div_ceil(8), 1)?;
+    length(Field::Calm, l.calm, frames.div_ceil(8), 1)?;
     if l.groups.len() % GROUP_RECORD_BYTES != 0 {
         return Err(BlobError::TableLength {
             field: Field::Groups,
@@ -538,6 +539,9 @@ fn control(c: &ControlSection) -> Result<(), BlobError> {
     }
     if c.beat_hold_ms > MAX_BEAT_HOLD_MS {
         return bad(Field::BeatHold);
+    }
+    if c.defer_cut_ms > MAX_DEFER_CUT_MS {
+        return bad(Field::DeferCut);
     }
     Ok(())
 }

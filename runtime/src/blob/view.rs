@@ -385,6 +385,7 @@ impl<'a> Blob<'a> {
             onset_window_ms: c.onset_window_ms as u32,
             max_wait_ms: c.max_wait_ms as u32,
             beat_hold_ms: c.beat_hold_ms as u32,
+            defer_cut_ms: c.defer_cut_ms as u32,
         }
     }
 
@@ -444,6 +445,15 @@ impl<'a> Blob<'a> {
         self.payload
             .library
             .beats
+            .get(f / 8)
+            .is_some_and(|b| b & (1 << (f % 8)) != 0)
+    }
+
+    /// Whether frame `f` of the frame table is calm (false out of range).
+    pub fn is_calm_frame(&self, f: usize) -> bool {
+        self.payload
+            .library
+            .calm
             .get(f / 8)
             .is_some_and(|b| b & (1 << (f % 8)) != 0)
     }

@@ -66,6 +66,7 @@ pub struct Tiny {
     pub labels: Vec<u8>,
     pub continues: Vec<u8>,
     pub beats: Vec<u8>,
+    pub calm: Vec<u8>,
     pub groups: Vec<u8>,
     pub rig_name: String,
     pub period_us: f32,
@@ -269,6 +270,7 @@ impl Tiny {
                 usage_ms: 30000,
                 blend_ms: 250,
                 beat_hold_ms: 150,
+                defer_cut_ms: 200,
             },
             channels: 1,
             fps: 30.0,
@@ -282,6 +284,7 @@ impl Tiny {
             labels: vec![0, 2],
             continues: vec![1, 0],
             beats: vec![0b0001_0010],
+            calm: vec![0b0010_0001],
             groups: vec![],
             rig_name: "tiny".into(),
             period_us: 20_000.0,
@@ -337,6 +340,7 @@ impl Tiny {
                 labels: &self.labels,
                 continues: &self.continues,
                 beats: &self.beats,
+                calm: &self.calm,
                 groups: &self.groups,
             },
             rig: RigSection {
@@ -382,13 +386,15 @@ pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-/// The tiny blob's bytes (format version 5: `styles` and `labels` absent, the final `00 00`;
-/// the `control` section after `policy.succ_cost_scale` is `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601`; the
-/// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4) and no `groups`,
+/// The tiny blob's bytes (format version 6: `styles` and `labels` absent, the final `00 00`;
+/// the `control` section after `policy.succ_cost_scale` is
+/// `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601 c801`; the
+/// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4), `calm` `01 21`
+/// (frames 0 and 5) and no `groups`,
 /// `00`). Changing the format changes
 /// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(
-    "4753544205000000cc01000022a23b92807d00009642000016448fc2f53c6666",
+    "4753544206000000d00100003997c3b0807d00009642000016448fc2f53c6666",
     "e63e0ad7233c3333b33e295c0f3e000000400000c8410000c84100008c420619",
     "02010134000000bf000080bf0000803e0000c0bf000000400000003f00008040",
     "0000a0bf0000003e0000003f000080be000000410000c03f0ad7233c0464009c",
@@ -396,13 +402,13 @@ pub const GOLDEN: &str = concat!(
     "003f080a0014001e0028000000803e0c0100020003000400050006000c000002",
     "0001000100010002001000000000020000000200000004000000100000050001",
     "00fbff0000070001000000cdcccc3d0132ac020000c03f882700008040b0ea01",
-    "fa019601010000f04106020800000000030000000403000300080ad7233c0000",
-    "20410c00006400c8002c019cff38ff04ffff0100020002020100011200047469",
-    "6e7900409c461c000000000000b4c20000b4420000803f0080bb440000204100",
-    "007a430468656164010209686970730a6865616404ffff000018000000000000",
-    "0000000000000000000000002041000000000206030900010205030405030424",
-    "000000000000b442000000000000000000000000000000000000000000000000",
-    "000000000e0100000000000000a04000000000060100010001010000",
+    "fa019601c801010000f04106020800000000030000000403000300080ad7233c",
+    "000020410c00006400c8002c019cff38ff04ffff010002000202010001120121",
+    "000474696e7900409c461c000000000000b4c20000b4420000803f0080bb4400",
+    "00204100007a430468656164010209686970730a6865616404ffff0000180000",
+    "0000000000000000000000000000000020410000000002060309000102050304",
+    "05030424000000000000b4420000000000000000000000000000000000000000",
+    "00000000000000000e0100000000000000a04000000000060100010001010000",
 );
 
 pub fn postcard_len<T: serde::Serialize>(v: &T) -> usize {

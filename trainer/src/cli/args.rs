@@ -220,6 +220,11 @@ pub struct DeviceArgs {
     /// holds).
     #[arg(long, default_value_t = DecisionTiming::DEFAULT.beat_hold_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_BEAT_HOLD_MS as i64))]
     pub beat_hold_ms: u32,
+    /// Longest delay of a cut decided in the middle of a segment until the playing
+    /// segment's hands pause (a motion beat), so the cut falls between strokes (ms; 0: cut
+    /// at once).
+    #[arg(long, default_value_t = DecisionTiming::DEFAULT.defer_cut_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_DEFER_CUT_MS as i64))]
+    pub defer_cut_ms: u32,
     /// Cost of entering a segment entered just now, falling to 0 over --recency-ms (0: no
     /// recency cost).
     #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.recency_cost, value_parser = cost_f32)]
@@ -260,6 +265,7 @@ impl DeviceArgs {
             ("--onset-window-ms", self.onset_window_ms, 1_000),
             ("--max-wait-ms", self.max_wait_ms, 5_000),
             ("--beat-hold-ms", self.beat_hold_ms, 1_000),
+            ("--defer-cut-ms", self.defer_cut_ms, 1_000),
         ] {
             if v > max {
                 return Err(format!("{name} must be at most {max}, not {v}").into());
@@ -278,6 +284,7 @@ impl DeviceArgs {
                 onset_window_ms: self.onset_window_ms,
                 max_wait_ms: self.max_wait_ms,
                 beat_hold_ms: self.beat_hold_ms,
+                defer_cut_ms: self.defer_cut_ms,
             }
         };
         opts.variety = gesture_runtime::policy::Variety {

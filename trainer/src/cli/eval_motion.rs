@@ -32,7 +32,7 @@ pub struct EvalMotionArgs {
     #[arg(long, value_parser = parse_span)]
     pub span: Option<(f64, f64)>,
     /// Random runs to average.
-    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub random_runs: u64,
     /// Runs of each device method (online and its ablations) to average, the speech delayed
     /// by 0.2 s more each time (the variety figures are of the first run).

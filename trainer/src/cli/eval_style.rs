@@ -29,6 +29,10 @@ pub struct EvalStyleArgs {
     /// `active=1` `sad=1` `active=0.5,sad=0.5`).
     #[arg(long, num_args = 1.., default_value = "neutral")]
     pub styles: Vec<String>,
+    /// Runs of each style to average, the speech delayed by 0.2 s more each time (one run is
+    /// one draw).
+    #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=100))]
+    pub device_runs: u64,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -63,7 +67,7 @@ pub fn run(a: &EvalStyleArgs) -> Result<(), CliError> {
         mocap: None,
         span: a.span,
         random_runs: 1,
-        device_runs: 1,
+        device_runs: a.device_runs,
         pack,
     };
     let model = InferenceModel::load(&a.model)?;
@@ -95,7 +99,7 @@ pub fn run(a: &EvalStyleArgs) -> Result<(), CliError> {
     for r in &ev.rows {
         let k = r.kinematics_ratio;
         outln!(
-            "{:<24} {:>9.2} {:>6.3} | {:>6.3} {:>6.3} {:>6.3} {:>6.3} {:>6.3} {:>6.3} | {:>5} {:>5}",
+            "{:<24} {:>9.2} {:>6.3} | {:>6.3} {:>6.3} {:>6.3} {:>6.3} {:>6.3} {:>6.3} | {:>5.1} {:>5.1}",
             r.style,
             r.hand_speed,
             r.hand_speed_ratio,

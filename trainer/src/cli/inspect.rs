@@ -63,7 +63,7 @@ pub fn summary(b: &Blob<'_>) -> String {
     let t = b.timing();
     let _ = writeln!(
         s,
-        "control: decisions {}",
+        "control: decisions {}; a cut decided mid-segment waits up to {} ms for the hands to pause",
         if t.sync_to_onsets {
             format!(
                 "on syllable onsets (within {} ms; a segment end waits up to {} ms)",
@@ -71,7 +71,8 @@ pub fn summary(b: &Blob<'_>) -> String {
             )
         } else {
             "at every exit point at once".to_string()
-        }
+        },
+        t.defer_cut_ms
     );
     let v = b.variety();
     let _ = writeln!(

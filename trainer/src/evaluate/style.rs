@@ -1,19 +1,23 @@
 //! What a style does to the played motion (`gesture-train eval-style`): the model and library
-//! packed with their tones, the device run on held-out speech once per style, and the played
+//! packed with their tones, the device run on held-out speech per style, and the played
 //! motion measured.
 //!
 //! Per style: the mean hand speed over the frames (the smoothed mean effector speed the
 //! segmentation uses, in skeleton units per second, i.e. cm/s for the shared captures), and the
 //! played motion segmented like the corpus, with the geometric mean over its segments of each
 //! kinematic parameter T, D, V, A, C, H (in body units: the space the tones are fitted in), and
-//! every figure's ratio to the first style given (neutral by convention). Like `eval-motion`,
+//! every figure's ratio to the first style given (neutral by convention). As in `eval-motion`,
+//! each style runs `device_runs` times with the speech delayed 0.2 s more each time (one run is
+//! one draw: on one minute of speech a single run's ratio to neutral moved by 0.2 from one
+//! setting to the next); the hand speed is the mean over the runs, the geometric means are
+//! over all the runs' segments, and the segment and decision counts are per run. Like `eval-motion`,
 //! everything runs the packed bytes through the runtime's device loop (`play_online`), the
 //! style set on its controller with `Controller::set_style`.
 
 use gesture_runtime::blob::Blob;
 use serde::Serialize;
 
-use super::motion::{load_audio, play_online, EvalError, MotionEval};
+use super::motion::{load_audio, play_delayed, EvalError, MotionEval, PHASE_STEP_S};
 use crate::control::style::parse_weights;
 use crate::inference::model::InferenceModel;
 use crate::motion::{analyze, SegmentParams};
@@ -31,14 +35,14 @@ pub struct StyleRow {
     pub hand_speed: f64,
     /// Geometric means of T, D, V, A, C, H over the played motion's segments (body units).
     pub kinematics: [f64; 6],
-    /// Segments of the played motion.
-    pub segments: usize,
+    /// Segments of the played motion (mean per run).
+    pub segments: f64,
     /// `hand_speed` over the first row's.
     pub hand_speed_ratio: f64,
     /// `kinematics` over the first row's.
     pub kinematics_ratio: [f64; 6],
-    /// Decisions made.
-    pub decisions: usize,
+    /// Decisions made (mean per run).
+    pub decisions: f64,
 }
 
 /// The result: one row per style.
@@ -80,32 +84,39 @@ pub fn evaluate_styles(
     let samples = load_audio(model, e)?;
     let seconds = samples.len() as f64 / model.sample_rate_hz as f64;
     let frames = (seconds * blob.fps() as f64) as usize;
+    let rate = model.sample_rate_hz;
+    let runs = e.device_runs.max(1) as usize;
+    let step = ((PHASE_STEP_S * blob.fps() as f64).round() as usize).max(1);
     let progress = crate::progress::spinner("eval-style: playing each style");
     let mut rows: Vec<StyleRow> = Vec::new();
     for (spec, w) in styles.iter().zip(&specs) {
         progress.set_message(format!("eval-style: {spec}"));
-        let mut refused = None;
-        let (played, made) = play_online(&blob, &samples, frames, |c| {
-            refused = c.set_style(w).err();
-        })?;
-        if let Some(err) = refused {
-            return Err(EvalError::Input(format!("--styles {spec}: {err}")));
+        let (mut speeds, mut logs, mut segments, mut decisions) = (0.0, [0.0f64; 6], 0usize, 0);
+        for run in 0..runs {
+            let mut refused = None;
+            let (played, made) = play_delayed(&blob, &samples, rate, frames, run * step, |c| {
+                refused = c.set_style(w).err();
+            })?;
+            if let Some(err) = refused {
+                return Err(EvalError::Input(format!("--styles {spec}: {err}")));
+            }
+            let motion = skeleton
+                .motion(&played.poses, blob.fps() as f64)
+                .map_err(|x| EvalError::Device(x.to_string()))?;
+            let an = analyze(&motion, &pack.effectors, &SegmentParams::default())
+                .map_err(|x| EvalError::Device(format!("the played motion of {spec}: {x}")))?;
+            speeds += an.speed.iter().sum::<f64>() / an.speed.len().max(1) as f64;
+            for k in &an.kinematics {
+                for (l, v) in logs.iter_mut().zip(k.to_array()) {
+                    *l += v.max(1e-9).ln();
+                }
+            }
+            segments += an.kinematics.len();
+            decisions += made.len();
         }
-        let motion = skeleton
-            .motion(&played.poses, blob.fps() as f64)
-            .map_err(|x| EvalError::Device(x.to_string()))?;
-        let an = analyze(&motion, &pack.effectors, &SegmentParams::default())
-            .map_err(|x| EvalError::Device(format!("the played motion of {spec}: {x}")))?;
-        let hand_speed = an.speed.iter().sum::<f64>() / an.speed.len().max(1) as f64;
-        let n = an.kinematics.len().max(1) as f64;
-        let kinematics: [f64; 6] = std::array::from_fn(|d| {
-            (an.kinematics
-                .iter()
-                .map(|k| k.to_array()[d].max(1e-9).ln())
-                .sum::<f64>()
-                / n)
-                .exp()
-        });
+        let hand_speed = speeds / runs as f64;
+        let kinematics: [f64; 6] =
+            std::array::from_fn(|d| (logs[d] / segments.max(1) as f64).exp());
         let (hs0, k0) = rows
             .first()
             .map_or((hand_speed, kinematics), |r| (r.hand_speed, r.kinematics));
@@ -114,10 +125,10 @@ pub fn evaluate_styles(
             weights: w.clone(),
             hand_speed,
             kinematics,
-            segments: an.kinematics.len(),
+            segments: segments as f64 / runs as f64,
             hand_speed_ratio: hand_speed / hs0.max(1e-12),
             kinematics_ratio: std::array::from_fn(|d| kinematics[d] / k0[d].max(1e-12)),
-            decisions: made.len(),
+            decisions: decisions as f64 / runs as f64,
         });
     }
     progress.finish_and_clear();

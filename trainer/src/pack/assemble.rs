@@ -15,7 +15,7 @@ use super::{PackError, PackOptions};
 use crate::control::build::ControlModel;
 use crate::control::semantic::{LabelParams, Labelling};
 use crate::control::Library;
-use crate::evaluate::metrics::beat_frames;
+use crate::evaluate::metrics::{beat_frames, quantile, smoothed_hand_speed};
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::inference_section;
 use crate::motion::Skeleton;
@@ -46,6 +46,30 @@ pub fn joint_specs(skeleton: &Skeleton) -> Vec<JointSpec<'_>> {
         .collect()
 }
 
+/// The quantile of the library's smoothed hand speeds at or below which a frame is calm.
+pub const CALM_QUANTILE: f64 = 0.3;
+
+/// The calm frames (indices into the frame table) of takes given as (first frame in the
+/// table, smoothed hand speed per frame): those whose speed is at most the
+/// [`CALM_QUANTILE`] of all the takes' speeds, where a cut decided mid-segment may fall
+/// (`DecisionTiming::defer_cut_ms`).
+pub fn calm_frames(takes: &[(usize, Vec<f64>)]) -> Vec<usize> {
+    let all: Vec<f64> = takes.iter().flat_map(|(_, s)| s.iter().copied()).collect();
+    if all.is_empty() {
+        return Vec::new();
+    }
+    let threshold = quantile(&all, CALM_QUANTILE);
+    takes
+        .iter()
+        .flat_map(|(first, s)| {
+            s.iter()
+                .enumerate()
+                .filter(move |(_, &v)| v <= threshold)
+                .map(move |(i, _)| first + i)
+        })
+        .collect()
+}
+
 /// The sections of `lib` through `rig` (the takes must share a skeleton); also returns the
 /// number of frames stored.
 pub fn parts(
@@ -59,6 +83,8 @@ pub fn parts(
     let mut frames: Vec<Vec<f32>> = Vec::new();
     let mut offsets = Vec::with_capacity(lib.takes.len());
     let mut beats = Vec::new();
+    // Per take, its first frame in the table and its hands' smoothed speed per frame.
+    let mut speeds: Vec<(usize, Vec<f64>)> = Vec::with_capacity(lib.takes.len());
     for t in &lib.takes {
         let pos = &t.analysis.positions;
         let hands: Vec<Vec<[f64; 3]>> = (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect();
@@ -67,6 +93,7 @@ pub fn parts(
                 .into_iter()
                 .map(|b| frames.len() + b),
         );
+        speeds.push((frames.len(), smoothed_hand_speed(&hands, t.motion.fps())));
         let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
         offsets.push(frames.len());
         let values = bound.take_values(&t.motion).ok_or_else(|| {
@@ -116,6 +143,7 @@ pub fn parts(
         })?;
         Some(OwnedSkeleton::new(&joint_specs(sk), &rest, &drives)?)
     };
+    let calm = calm_frames(&speeds);
     let n = frames.len();
     Ok((
         Parts {
@@ -133,7 +161,8 @@ pub fn parts(
                     &lib.takes[0].motion.skeleton().clone(),
                     &lib.takes[0].source.display().to_string(),
                 )?,
-            )?,
+            )?
+            .with_calm(&calm),
             rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
             skeleton,
         },
@@ -292,4 +321,18 @@ pub fn rotation_groups(
         }
     }
     Ok(groups)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn calm_frames_are_those_at_or_below_the_30th_percentile_of_all_takes() {
+        // Speeds 0..=6 over two takes: the 30th percentile (nearest rank) is 2.
+        let takes = [(0, vec![5.0, 1.0, 3.0, 2.0]), (4, vec![4.0, 0.0, 6.0])];
+        assert_eq!(calm_frames(&takes), [1, 3, 5]);
+        assert!(calm_frames(&[]).is_empty());
+        assert!(calm_frames(&[(0, vec![])]).is_empty());
+    }
 }
