@@ -58,6 +58,17 @@ struct Lib {
     calm: bool,
 }
 
+impl Lib {
+    /// Segments of 20, 12 and 30 frames, no beats, no calm frames.
+    fn plain() -> Self {
+        Self {
+            lens: [20, 12, 30],
+            beat_every: 0,
+            calm: false,
+        }
+    }
+}
+
 impl LibraryFrames for Lib {
     fn channels(&self) -> usize {
         2
@@ -152,23 +163,16 @@ fn run_with(audio: &[i16], chunk: usize, finish: bool) -> Vec<Rec> {
 }
 
 fn run_timed(audio: &[i16], chunk: usize, finish: bool, timing: DecisionTiming) -> Vec<Rec> {
-    run_varied(audio, chunk, finish, timing, Variety::NONE, None)
-}
-
-fn run_varied(
-    audio: &[i16],
-    chunk: usize,
-    finish: bool,
-    timing: DecisionTiming,
-    variety: Variety,
-    held: Option<&[f32]>,
-) -> Vec<Rec> {
-    let lib = Lib {
-        lens: [20, 12, 30],
-        beat_every: 0,
-        calm: false,
-    };
-    run_on(&lib, audio, chunk, finish, timing, variety, held, false)
+    run_on(
+        &Lib::plain(),
+        audio,
+        chunk,
+        finish,
+        timing,
+        Variety::NONE,
+        None,
+        false,
+    )
 }
 
 /// A run over `lib`; with `shown`, each pose is followed by what it showed
@@ -346,11 +350,7 @@ fn garbage_audio_keeps_producing_valid_poses() {
 #[test]
 fn new_in_builds_in_place_what_new_builds() {
     let t = tables();
-    let lib = Lib {
-        lens: [20, 12, 30],
-        beat_every: 0,
-        calm: false,
-    };
+    let lib = Lib::plain();
     let init = [0u8; 4];
     let mut trans = Vec::new();
     for v in [400i16, -400, -400, 400] {
@@ -574,13 +574,15 @@ fn the_pure_policy_repeats_itself_and_recency_costs_stop_it() {
         usage_cost: 0.0,
         usage_ms: 0,
     };
-    let varied = entries(&run_varied(
+    let varied = entries(&run_on(
+        &Lib::plain(),
         &silence,
         500,
         false,
         DecisionTiming::IMMEDIATE,
         v,
         None,
+        false,
     ));
     let distinct: std::collections::BTreeSet<usize> = varied.iter().map(|&(_, c)| c).collect();
     assert_eq!(distinct.len(), 3, "{varied:?}");
@@ -596,13 +598,15 @@ fn a_held_belief_decides_instead_of_the_crf() {
     // 1.5 + 0.4: always segment 0. Held on state 1: segment 1 (1.0 + 0.2).
     let silence = vec![0i16; 16_000 * 4];
     for (held, want) in [([1.0f32, 0.0], 0usize), ([0.0, 1.0], 1)] {
-        let e = entries(&run_varied(
+        let e = entries(&run_on(
+            &Lib::plain(),
             &silence,
             500,
             false,
             DecisionTiming::IMMEDIATE,
             Variety::NONE,
             Some(&held),
+            false,
         ));
         assert!(!e.is_empty());
         assert!(e.iter().all(|&(_, c)| c == want), "{held:?}: {e:?}");
