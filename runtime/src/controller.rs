@@ -141,8 +141,8 @@ pub struct DecisionTiming {
     pub max_wait_ms: u32,
     /// Longest hold (ms) at a motion beat waiting for an onset (0: no holds).
     pub beat_hold_ms: u32,
-    /// Longest delay (ms) of a cut decided mid-segment until the hands pause (a motion beat
-    /// of the playing segment; 0: cut at once).
+    /// Longest delay (ms) of a cut decided mid-segment until the playing segment shows a pause
+    /// of the hands (a motion beat, a calm frame or its last frame; 0: cut at once).
     pub defer_cut_ms: u32,
 }
 
@@ -893,7 +893,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                         }
                     }
                 }
-                // The frame just shown (the player has moved past it unless it holds the last).
+                // The frame just shown (the player has moved past it), or the last frame once
+                // the player stands at it (having shown it or the one before): a pause.
                 let shown = if self.player.at_end(self.lib) {
                     self.player.frame()
                 } else {

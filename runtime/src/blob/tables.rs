@@ -107,12 +107,12 @@ impl LibraryFrames for Blob<'_> {
         Blob::continues(self, c)
     }
     fn is_beat(&self, c: usize, f: usize) -> bool {
-        self.segment(c)
-            .is_some_and(|s| f < s.len as usize && self.is_beat_frame(s.start as usize + f))
+        self.table_frame(c, f)
+            .is_some_and(|t| self.is_beat_frame(t))
     }
     fn is_calm(&self, c: usize, f: usize) -> bool {
-        self.segment(c)
-            .is_some_and(|s| f < s.len as usize && self.is_calm_frame(s.start as usize + f))
+        self.table_frame(c, f)
+            .is_some_and(|t| self.is_calm_frame(t))
     }
     fn group_count(&self) -> usize {
         Blob::group_count(self)

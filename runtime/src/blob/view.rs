@@ -145,6 +145,11 @@ pub struct Blob<'a> {
     label_u_cont: I16Table<'a>,
 }
 
+/// Bit `f` of a per-frame bitset (bit `f % 8` of byte `f / 8`; false out of range).
+fn frame_bit(bits: &[u8], f: usize) -> bool {
+    bits.get(f / 8).is_some_and(|b| b & (1 << (f % 8)) != 0)
+}
+
 impl<'a> Blob<'a> {
     /// Checks `bytes` completely (header, CRC, decoding, every field) and returns the
     /// validated blob, or the first rule broken. Never panics, never allocates.
@@ -442,20 +447,12 @@ impl<'a> Blob<'a> {
 
     /// Whether frame `f` of the frame table is a motion beat (false out of range).
     pub fn is_beat_frame(&self, f: usize) -> bool {
-        self.payload
-            .library
-            .beats
-            .get(f / 8)
-            .is_some_and(|b| b & (1 << (f % 8)) != 0)
+        frame_bit(self.payload.library.beats, f)
     }
 
     /// Whether frame `f` of the frame table is calm (false out of range).
     pub fn is_calm_frame(&self, f: usize) -> bool {
-        self.payload
-            .library
-            .calm
-            .get(f / 8)
-            .is_some_and(|b| b & (1 << (f % 8)) != 0)
+        frame_bit(self.payload.library.calm, f)
     }
 
     /// Rotation groups (records of `library.groups`).
@@ -496,10 +493,14 @@ impl<'a> Blob<'a> {
     /// Value of channel `ch` at frame `f` of segment `seg` (degrees; 0 out of range).
     #[inline]
     pub fn segment_value(&self, seg: usize, f: usize, ch: usize) -> f32 {
-        match self.segment(seg) {
-            Some(s) if f < s.len as usize => self.frame(ch, s.start as usize + f),
-            _ => 0.0,
-        }
+        self.table_frame(seg, f).map_or(0.0, |t| self.frame(ch, t))
+    }
+
+    /// Frame `f` of segment `seg` as an index into the frame table (`None` out of range).
+    pub fn table_frame(&self, seg: usize, f: usize) -> Option<usize> {
+        self.segment(seg)
+            .filter(|s| f < s.len as usize)
+            .map(|s| s.start as usize + f)
     }
 
     /// The pose at frame `f` of the frame table into `out` (as many channels as fit); returns

@@ -404,7 +404,11 @@ pub fn speech_coupling(hands: &[Vec<Vec3>], fps: f64, spans: &[(f64, f64, f64)])
 /// The pauses of the hands: frame `i` where the smoothed mean hand speed from frame `i` to
 /// `i + 1` is a local minimum (where `pack` lets a beat hold wait for an onset).
 pub fn beat_frames(hands: &[Vec<Vec3>], fps: f64) -> Vec<usize> {
-    let sp = smoothed_hand_speed(hands, fps);
+    speed_minima(&smoothed_hand_speed(hands, fps))
+}
+
+/// The frames `i` where `sp[i]` is a local minimum ([`beat_frames`] of a smoothed speed).
+pub fn speed_minima(sp: &[f64]) -> Vec<usize> {
     (1..sp.len().saturating_sub(1))
         .filter(|&i| sp[i] < sp[i - 1] && sp[i] <= sp[i + 1])
         .collect()

@@ -6,13 +6,14 @@
 //! segmentation uses, in skeleton units per second, i.e. cm/s for the shared captures), and the
 //! played motion segmented like the corpus, with the geometric mean over its segments of each
 //! kinematic parameter T, D, V, A, C, H (in body units: the space the tones are fitted in), and
-//! every figure's ratio to the first style given (neutral by convention). As in `eval-motion`,
-//! each style runs `device_runs` times with the speech delayed 0.2 s more each time (one run is
-//! one draw: on one minute of speech a single run's ratio to neutral moved by 0.2 from one
-//! setting to the next); the hand speed is the mean over the runs, the geometric means are
-//! over all the runs' segments, and the segment and decision counts are per run. Like `eval-motion`,
-//! everything runs the packed bytes through the runtime's device loop (`play_online`), the
-//! style set on its controller with `Controller::set_style`.
+//! every figure's ratio to the first style given (neutral by convention).
+//!
+//! As in `eval-motion`, everything runs the packed bytes through the runtime's device loop
+//! (the style set on its controller with `Controller::set_style`), `device_runs` times per
+//! style with the speech delayed 0.2 s more each time: one run is one draw (single runs put
+//! active at x1.03 to x1.24 on the two beat-scott monologues). The hand speed is the mean over
+//! the runs, the geometric means are over all the runs' segments, and the segment and
+//! decision counts are per run.
 
 use gesture_runtime::blob::Blob;
 use serde::Serialize;

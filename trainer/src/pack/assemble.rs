@@ -15,7 +15,7 @@ use super::{PackError, PackOptions};
 use crate::control::build::ControlModel;
 use crate::control::semantic::{LabelParams, Labelling};
 use crate::control::Library;
-use crate::evaluate::metrics::{beat_frames, quantile, smoothed_hand_speed};
+use crate::evaluate::metrics::{quantile, smoothed_hand_speed, speed_minima};
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::inference_section;
 use crate::motion::Skeleton;
@@ -88,12 +88,9 @@ pub fn parts(
     for t in &lib.takes {
         let pos = &t.analysis.positions;
         let hands: Vec<Vec<[f64; 3]>> = (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect();
-        beats.extend(
-            beat_frames(&hands, t.motion.fps())
-                .into_iter()
-                .map(|b| frames.len() + b),
-        );
-        speeds.push((frames.len(), smoothed_hand_speed(&hands, t.motion.fps())));
+        let speed = smoothed_hand_speed(&hands, t.motion.fps());
+        beats.extend(speed_minima(&speed).into_iter().map(|b| frames.len() + b));
+        speeds.push((frames.len(), speed));
         let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
         offsets.push(frames.len());
         let values = bound.take_values(&t.motion).ok_or_else(|| {
