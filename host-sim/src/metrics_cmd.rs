@@ -85,6 +85,8 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
             .iter()
             .map(|s| (s.start_s, s.start_s + s.length_s, s.intensity_db))
             .collect(),
+        // No audio read yet: no voice figures.
+        active: Vec::new(),
     };
     let reference = match mocap {
         Some(p) => {

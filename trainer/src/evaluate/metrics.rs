@@ -43,7 +43,11 @@
 //! - **the hands' speed distribution** against a reference (GENEA's Hellinger distance of
 //!   hand-speed histograms, 10 units/s bins up to 250 and one overflow bin): the capture of
 //!   the same speech when there is one; `eval-motion` otherwise builds one from the
-//!   library's capture in speech like this ([`crate::evaluate::motion`]).
+//!   library's capture in speech like this ([`crate::evaluate::motion`]);
+//! - **voice**: whether the body follows the voice: the hands' speed (relative to the chest)
+//!   in the speech's pauses over their speed in speech, how soon they settle once the voice
+//!   stops and how soon they move once it returns, and their speed in speech (voice activity
+//!   from the audio's loudness; see [`crate::evaluate::voice`] for the definitions).
 //!
 //! Pure functions of their inputs; no panics on empty or short traces (figures of an empty
 //! trace are 0).
@@ -73,6 +77,10 @@ pub struct Speech {
     pub onsets: Vec<f64>,
     /// Steps (syllables and pauses): start (s), end (s), mean intensity (dB).
     pub spans: Vec<(f64, f64, f64)>,
+    /// Per 10 ms audio frame from the trace's start, whether the voice is active
+    /// ([`crate::evaluate::voice::activity`]); empty without the audio (the voice figures are
+    /// then `None`).
+    pub active: Vec<bool>,
 }
 
 impl Speech {
@@ -89,7 +97,14 @@ impl Speech {
                 .iter()
                 .map(|s| (s.start_s(), s.end_s(), s.intensity_db as f64))
                 .collect(),
+            active: Vec::new(),
         }
+    }
+
+    /// With the voice activity of `samples` (at `rate` Hz, starting where the trace starts).
+    pub fn with_audio(mut self, samples: &[i16], rate: u32) -> Self {
+        self.active = crate::evaluate::voice::activity(samples, rate);
+        self
     }
 }
 
@@ -112,6 +127,9 @@ pub struct Trace {
     pub fps: f64,
     /// Per frame, the hands' world positions.
     pub hands: Vec<Vec<Vec3>>,
+    /// Per frame, the world position of the hands' nearest common ancestor joint
+    /// ([`crate::evaluate::voice::anchor_joint`]); empty when unknown.
+    pub anchor: Vec<Vec3>,
     /// Per frame, the foot and toe joints' world positions (empty rows: no feet).
     pub feet: Vec<Vec<Vec3>>,
     /// Per frame, every joint rotation channel (degrees).
@@ -167,7 +185,8 @@ pub fn entries_from_frames(
 }
 
 impl Trace {
-    /// The trace of `motion` (hands found by `hands`, feet by [`feet`]) with `entries`.
+    /// The trace of `motion` (hands found by `hands`, their anchor by
+    /// [`crate::evaluate::voice::anchor_joint`], feet by [`feet`]) with `entries`.
     pub fn from_motion(
         motion: &Motion,
         hands: &EffectorSpec,
@@ -185,6 +204,15 @@ impl Trace {
             Ok((0..p.frames()).map(|f| p.frame(f).to_vec()).collect())
         };
         let foot_targets: Vec<Target> = feet(sk).into_iter().map(Target::Joint).collect();
+        // The anchor rides along with the hands' FK as one more target.
+        let anchor = crate::evaluate::voice::anchor_joint(sk, &eff.targets);
+        let mut hand_targets = eff.targets.clone();
+        hand_targets.extend(anchor.map(Target::Joint));
+        let mut hands = fk(&hand_targets).map_err(|e| e.to_string())?;
+        let anchor: Vec<Vec3> = match anchor {
+            Some(_) => hands.iter_mut().filter_map(|row| row.pop()).collect(),
+            None => Vec::new(),
+        };
         let rot: Vec<usize> = {
             let mut v = Vec::new();
             let mut k = 0;
@@ -200,7 +228,8 @@ impl Trace {
         };
         Ok(Self {
             fps: motion.fps(),
-            hands: fk(&eff.targets).map_err(|e| e.to_string())?,
+            hands,
+            anchor,
             feet: fk(&foot_targets).map_err(|e| e.to_string())?,
             rotations: (0..motion.frames())
                 .map(|f| {
@@ -266,6 +295,15 @@ pub struct MotionMetrics {
     pub speech_coupling: f64,
     /// Hellinger distance of the hand-speed histogram to the reference (`None` without one).
     pub hellinger: Option<f64>,
+    /// Median hand speed (relative to the anchor) in the speech's pauses over that in speech
+    /// ([`crate::evaluate::voice`]; `None` without pauses or audio).
+    pub pause_ratio: Option<f64>,
+    /// Median time (s) from a pause's start until the hands settle.
+    pub settle_s: Option<f64>,
+    /// Median time (s) from the speech's return after a pause until the hands move.
+    pub react_s: Option<f64>,
+    /// Median hand speed (relative to the anchor) while the voice is active (units/s).
+    pub speech_speed: Option<f64>,
 }
 
 fn dist(a: &Vec3, b: &Vec3) -> f64 {
@@ -655,6 +693,12 @@ pub fn measure(
     m.beat_chance = beat_chance(onsets, &beats, seconds, BEAT_SIGMA_S);
     m.beat_lift = m.beat_alignment - m.beat_chance;
     m.hellinger = reference.map(|r| hellinger(&speed_histogram(h, fps), r));
+    // Does the body follow the voice.
+    let v = crate::evaluate::voice::measure_voice(t, &speech.active);
+    m.pause_ratio = v.pause_ratio;
+    m.settle_s = v.settle_s;
+    m.react_s = v.react_s;
+    m.speech_speed = v.speech_speed;
     m
 }
 
@@ -668,6 +712,7 @@ mod tests {
             hands: (0..frames)
                 .map(|f| vec![[f as f64, 0.0, 0.0], [0.0, f as f64, 0.0]])
                 .collect(),
+            anchor: Vec::new(),
             feet: vec![Vec::new(); frames],
             rotations: (0..frames).map(|f| vec![f as f64]).collect(),
             entries,
@@ -944,10 +989,12 @@ mod tests {
         let speech = Speech {
             onsets: vec![1.0],
             spans: vec![(0.0, 2.0, 60.0)],
+            active: vec![false; 300],
         };
         let m = measure(&Trace::default(), &speech, Some(3), None);
         assert_eq!(m.entries, 0);
         assert_eq!(m.seconds, 0.0);
         assert_eq!(m.speech_coupling, 0.0);
+        assert_eq!(m.pause_ratio, None);
     }
 }

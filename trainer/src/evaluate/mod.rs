@@ -5,6 +5,8 @@
 //!   smoothness, beats, hand speeds), from poses on the library's skeleton.
 //! - [`motion`]: motion quality of the online controller on held-out audio against its
 //!   ablations, random selection, the offline DP reference and the motion capture.
+//! - [`voice`]: whether the body follows the voice: the hands' speed in the speech's pauses
+//!   against in speech, and how soon they settle and move again (part of [`metrics`]).
 //! - [`style`]: what each style (tone mix) does to the played motion;
 //! - [`table`]: the printed table of those figures.
 
@@ -12,3 +14,4 @@ pub mod metrics;
 pub mod motion;
 pub mod style;
 pub mod table;
+pub mod voice;

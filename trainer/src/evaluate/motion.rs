@@ -400,6 +400,11 @@ fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
     let avg = |f: fn(&MotionMetrics) -> f64| ms.iter().map(f).sum::<f64>() / n;
     let avg_opt =
         |f: fn(&MotionMetrics) -> Option<f64>| ms.iter().map(f).sum::<Option<f64>>().map(|v| v / n);
+    // The voice figures are `None` in a run without a pause in reach: the mean of the others.
+    let avg_some = |f: fn(&MotionMetrics) -> Option<f64>| {
+        let v: Vec<f64> = ms.iter().filter_map(f).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
     MotionMetrics {
         seconds: avg(|m| m.seconds),
         still_share: avg(|m| m.still_share),
@@ -415,6 +420,10 @@ fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
         beat_lift: avg(|m| m.beat_lift),
         speech_coupling: avg(|m| m.speech_coupling),
         hellinger: avg_opt(|m| m.hellinger),
+        pause_ratio: avg_some(|m| m.pause_ratio),
+        settle_s: avg_some(|m| m.settle_s),
+        react_s: avg_some(|m| m.react_s),
+        speech_speed: avg_some(|m| m.speech_speed),
         // Variety of one run (averages of counts mean little).
         ..ms.first().copied().unwrap_or_default()
     }
@@ -586,7 +595,9 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     let fps = lib.fps;
     let seconds = samples.len() as f64 / rate as f64;
     let frames = (seconds * fps) as usize;
-    let speech = Speech::from_steps(&steps);
+    // The measured traces start where the speech starts (a delayed run's lead is cut off), so
+    // the loudness frames of the samples line up with trace time 0.
+    let speech = Speech::from_steps(&steps).with_audio(&samples, rate);
     let reference = match &e.mocap {
         Some(p) => Some(mocap_trace(p, e, |mo_fps| (seconds * mo_fps) as usize)?),
         None => None,
@@ -855,5 +866,24 @@ mod tests {
         assert!((s.beat_alignment - 0.1 / r2).abs() < 1e-12);
         assert!((s.hellinger.unwrap() - 0.2 / r2).abs() < 1e-12);
         assert_eq!(spread(&[a]), None);
+    }
+
+    /// The voice figures average over the runs that have them (a run may have no pause in
+    /// reach); `None` only when no run has one.
+    #[test]
+    fn voice_figures_average_over_the_runs_that_have_them() {
+        let run = |r: Option<f64>| MotionMetrics {
+            pause_ratio: r,
+            settle_s: r.map(|v| 10.0 * v),
+            react_s: None,
+            speech_speed: r.map(|v| 100.0 * v),
+            ..MotionMetrics::default()
+        };
+        let m = mean(&[run(Some(0.1)), run(None), run(Some(0.3))]);
+        assert!((m.pause_ratio.unwrap() - 0.2).abs() < 1e-12, "{m:?}");
+        assert!((m.settle_s.unwrap() - 2.0).abs() < 1e-12);
+        assert!((m.speech_speed.unwrap() - 20.0).abs() < 1e-12);
+        assert_eq!(m.react_s, None);
+        assert_eq!(mean(&[run(None), run(None)]).pause_ratio, None);
     }
 }

@@ -1,6 +1,6 @@
 //! The motion-quality table as both command lines print it (`gesture-train eval-motion`,
-//! `gesture-sim metrics`): one block of variety figures and one of motion figures, a row per
-//! method, units in the headers.
+//! `gesture-sim metrics`): one block of variety figures, one of motion figures and one of
+//! how the body follows the voice, a row per method, units in the headers ("-": no figure).
 
 use super::metrics::MotionMetrics;
 
@@ -48,6 +48,19 @@ pub fn motion_table(rows: &[(&str, &MotionMetrics)]) -> Vec<String> {
             m.beat_alignment,
             m.beat_lift,
             opt(m.hellinger, 3)
+        ));
+    }
+    out.push(
+        "voice                pause/speech  settle (s)  react (s)  speech speed (cm/s)".to_string(),
+    );
+    for (name, m) in rows {
+        out.push(format!(
+            "{:<20} {:>12} {:>11} {:>10} {:>20}",
+            name,
+            opt(m.pause_ratio, 3),
+            opt(m.settle_s, 2),
+            opt(m.react_s, 2),
+            opt(m.speech_speed, 1)
         ));
     }
     out.push("(lengths in skeleton units: cm on the shared data)".to_string());
