@@ -4,10 +4,17 @@
 //! (`gesture_trainer::evaluate::metrics`). Any device that writes the same two files can be
 //! judged this way. With `--mocap`, the hands' speeds are compared with a capture's, as the
 //! character shows it (no walking: `gesture_trainer::evaluate::motion::shown_speed_histogram`).
+//!
+//! The voice figures (`gesture_trainer::evaluate::voice`) need the speech's samples: the
+//! run's `speech.wav` when the folder has one (`run --blender` writes it), else the audio file
+//! the timeline names (`"audio"`, as it was given to `run`: relative to where `run` ran, or to
+//! the folder), read at the timeline's sample rate. When neither can be read the four figures
+//! are `None` ("-" in the table, with a note saying why); nothing stands in for the audio.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use gesture_trainer::audio::load_wav_at;
 use gesture_trainer::evaluate::metrics::{measure, Entry, MotionMetrics, Speech, Trace};
 use gesture_trainer::evaluate::motion::shown_speed_histogram;
 use gesture_trainer::evaluate::table::motion_table;
@@ -22,6 +29,12 @@ struct TimelineIn {
     format: String,
     version: u32,
     segments: usize,
+    /// The audio file given to `run`.
+    #[serde(default)]
+    audio: Option<String>,
+    /// The blob's sample rate (the samples the device heard).
+    #[serde(default)]
+    sample_rate_hz: Option<u32>,
     steps: Vec<StepIn>,
     entries: Vec<EntryIn>,
 }
@@ -45,8 +58,47 @@ fn bad(path: &Path, reason: impl std::fmt::Display) -> SimError {
     SimError::Metrics(format!("{}: {reason}", path.display()))
 }
 
+/// The speech's samples at the run's rate (see the module docs), or why there are none.
+fn run_audio(dir: &Path, tl: &TimelineIn) -> Result<(Vec<i16>, u32), String> {
+    let rate = tl
+        .sample_rate_hz
+        .ok_or("the timeline does not give the sample rate")?;
+    let mut tried = vec![dir.join("speech.wav")];
+    if let Some(a) = &tl.audio {
+        let p = PathBuf::from(a);
+        if p.is_relative() {
+            tried.push(dir.join(&p));
+        }
+        tried.insert(1, p);
+    }
+    for p in &tried {
+        if p.is_file() {
+            return load_wav_at(p, rate)
+                .map(|pcm| (pcm.samples, rate))
+                .map_err(|e| e.to_string());
+        }
+    }
+    Err(format!(
+        "no speech audio: looked for {}",
+        tried
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
+}
+
 /// The figures of the run in `dir`; `mocap` compares the hands' speeds with a capture.
+/// Without the run's audio (see the module docs) the voice figures are `None`.
 pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, SimError> {
+    run_metrics_noted(dir, mocap).map(|(m, _)| m)
+}
+
+/// [`run_metrics`], and why the voice figures are missing when they are for want of audio.
+pub fn run_metrics_noted(
+    dir: &Path,
+    mocap: Option<&Path>,
+) -> Result<(MotionMetrics, Option<String>), SimError> {
     let tl_path = dir.join("timeline.json");
     let text = std::fs::read_to_string(&tl_path).map_err(|e| bad(&tl_path, e))?;
     let tl: TimelineIn = serde_json::from_str(&text).map_err(|e| bad(&tl_path, e))?;
@@ -73,7 +125,7 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
         .collect();
     let trace =
         Trace::from_motion(&motion, &EffectorSpec::default(), entries).map_err(|e| bad(&bvh, e))?;
-    let speech = Speech {
+    let mut speech = Speech {
         onsets: tl
             .steps
             .iter()
@@ -85,8 +137,15 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
             .iter()
             .map(|s| (s.start_s, s.start_s + s.length_s, s.intensity_db))
             .collect(),
-        // No audio read yet: no voice figures.
         active: Vec::new(),
+    };
+    // motion.bvh's tick 0 is the audio's time 0, as the steps' times are.
+    let note = match run_audio(dir, &tl) {
+        Ok((samples, rate)) => {
+            speech = speech.with_audio(&samples, rate);
+            None
+        }
+        Err(why) => Some(why),
     };
     let reference = match mocap {
         Some(p) => {
@@ -95,12 +154,8 @@ pub fn run_metrics(dir: &Path, mocap: Option<&Path>) -> Result<MotionMetrics, Si
         }
         None => None,
     };
-    Ok(measure(
-        &trace,
-        &speech,
-        Some(tl.segments),
-        reference.as_deref(),
-    ))
+    let m = measure(&trace, &speech, Some(tl.segments), reference.as_deref());
+    Ok((m, note))
 }
 
 /// `gesture-sim metrics`: prints the table (or JSON) for the run in `dir`.
@@ -110,13 +165,16 @@ pub fn run(
     json: bool,
     out: &mut impl Write,
 ) -> Result<(), SimError> {
-    let m = run_metrics(dir, mocap.map(PathBuf::as_path))?;
+    let (m, note) = run_metrics_noted(dir, mocap.map(PathBuf::as_path))?;
     if json {
         writeln!(out, "{}", serde_json::to_string(&m).unwrap_or_default())?;
         return Ok(());
     }
     for line in motion_table(&[("run", &m)]) {
         writeln!(out, "{line}")?;
+    }
+    if let Some(why) = note {
+        writeln!(out, "(no voice figures: {why})")?;
     }
     Ok(())
 }

@@ -136,6 +136,48 @@ fn metrics_of_a_run_folder_agree_with_its_timeline() {
     let o = sim(&["metrics", out.to_str().unwrap()]);
     assert!(o.status.success());
     assert!(text(&o.stdout).contains("(cm/s)"));
+    // The voice figures come from the audio the timeline names. The setup's speech has no
+    // pause of 1.5 s (they are null there); the same speech twice with 3 s of silence between
+    // has one.
+    let mut r = hound::WavReader::open(&s.wav).unwrap();
+    let spec = r.spec();
+    let speech: Vec<i16> = r.samples::<i16>().map(Result::unwrap).collect();
+    let paused = s.root.join("metrics-paused.wav");
+    let mut w = hound::WavWriter::create(&paused, spec).unwrap();
+    let silence = 3 * spec.sample_rate as usize * spec.channels as usize;
+    for v in speech.iter().chain(&vec![0; silence]).chain(&speech) {
+        w.write_sample(*v).unwrap();
+    }
+    w.finalize().unwrap();
+    let out_paused = s.root.join("out-metrics-paused");
+    let o = run_into(&s.full, &paused, &out_paused, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let o = sim(&["metrics", out_paused.to_str().unwrap(), "--json"]);
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for k in ["pause_ratio", "settle_s", "react_s", "speech_speed"] {
+        assert!(
+            m[k].as_f64().is_some_and(|v| v.is_finite() && v >= 0.0),
+            "{k}: {m}"
+        );
+    }
+    // Without the audio they are null (and the table says why), the other figures the same.
+    let lost = s.root.join("metrics-no-audio");
+    std::fs::create_dir_all(&lost).unwrap();
+    std::fs::copy(out_paused.join("motion.bvh"), lost.join("motion.bvh")).unwrap();
+    let mut tl_lost: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_paused.join("timeline.json")).unwrap())
+            .unwrap();
+    tl_lost["audio"] = "no-such-folder/speech.wav".into();
+    std::fs::write(lost.join("timeline.json"), tl_lost.to_string()).unwrap();
+    let o = sim(&["metrics", lost.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let m_lost: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for k in ["pause_ratio", "settle_s", "react_s", "speech_speed"] {
+        assert!(m_lost[k].is_null(), "{k}: {m_lost}");
+    }
+    assert_eq!(m_lost["speech_coupling"], m["speech_coupling"]);
+    let o = sim(&["metrics", lost.to_str().unwrap()]);
+    assert!(text(&o.stdout).contains("(no voice figures: no speech audio"));
     // A folder without a timeline, and a timeline of the first version.
     let empty = s.root.join("metrics-empty");
     std::fs::create_dir_all(&empty).unwrap();
