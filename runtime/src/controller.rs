@@ -56,6 +56,7 @@
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
 use crate::blob::Blob;
+use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
 use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
@@ -272,6 +273,7 @@ impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
         me.timing = blob.timing();
         me.variety = blob.variety();
         me.label_timeout_ms = blob.label_timeout_ms();
+        me.set_follow(blob.follow());
         let blend = me.ms_ticks(blob.blend_ms());
         me.player.set_blend_ticks(blend);
         me.player
@@ -323,6 +325,14 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     waited: u64,
     /// A cut decided and waiting for the hands to pause: segment, entry frame, ticks waited.
     deferred: Option<(usize, usize, u64)>,
+    /// How the character follows the voice.
+    follow: VoiceFollow,
+    /// The voice as followed: silence, level, rest.
+    voice: Voice,
+    /// The calmest segments (candidates while resting).
+    rest: RestSet,
+    /// Length of a pause step (ms).
+    pause_ms: u32,
 }
 
 impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
@@ -383,6 +393,10 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             waiting: None,
             waited: 0,
             deferred: None,
+            follow: VoiceFollow::NONE,
+            voice: Voice::new(),
+            rest: RestSet::EMPTY,
+            pause_ms: config.syllables.pause_frames.saturating_mul(10),
         });
         if let Err(e) = me.front_end.configure(config) {
             *slot = None;
@@ -440,6 +454,27 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             h[..b.len()].copy_from_slice(b);
             h
         });
+    }
+
+    /// Sets how the character follows the voice (the default is the blob's; docs in
+    /// [`crate::follow`]).
+    pub fn set_follow(&mut self, follow: VoiceFollow) {
+        self.follow = follow;
+        self.rest = if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
+            RestSet::of(self.tables, self.lib.segment_count())
+        } else {
+            RestSet::EMPTY
+        };
+    }
+
+    /// How the character follows the voice.
+    pub fn follow(&self) -> VoiceFollow {
+        self.follow
+    }
+
+    /// Whether the character rests (the speech has been silent for the blob's `rest_ms`).
+    pub fn resting(&self) -> bool {
+        self.voice.resting()
     }
 
     /// Sets how decisions vary (the default is the blob's).
@@ -660,14 +695,17 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             self.tables.states(),
         );
         let (last_onset, now) = (&mut self.last_onset, self.ticks);
+        let (voice, follow, pause_ms) = (&mut self.voice, &self.follow, self.pause_ms);
         let mut on_event = |ev| match ev {
             Event::Frame(f) => sink(ControllerEvent::Frame(f)),
             Event::Onset(frame) => {
                 *last_onset = Some(now);
+                voice.onset();
                 sink(ControllerEvent::Onset(frame));
             }
             Event::Step(step) => {
                 let x = normalizer.push(&step);
+                voice.step(follow, x.pause, x.obs[0], pause_ms);
                 let mut m = [0.0f32; MAX_CLUSTERS];
                 memberships(&gmm[..clusters], &x, &mut m);
                 belief.step(crf, &m);
@@ -704,6 +742,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             && self.lib.is_beat(segment, self.player.frame());
         let hold = at_beat && !fresh && !self.ticks_reach_ms(self.holding + 1, t.beat_hold_ms);
         self.holding = if hold { self.holding + 1 } else { 0 };
+        self.player.set_rate(if self.voice.resting() {
+            crate::follow::rest_rate(self.tables.energy(segment))
+        } else {
+            1.0
+        });
         let played = self.player.tick_advancing(self.lib, &mut self.pose, !hold);
         // What leaves the controller is within the rig's limits and finite, whatever the
         // frames and the blend made of it (a board without the rig's own clamp must not drive
@@ -732,6 +775,16 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             frame: played,
         });
         self.labels_after_tick(tick, segment, played, sink);
+        if self.follow_voice(segment, tick, sink) {
+            return;
+        }
+        if self.voice.resting() && self.rest.contains(segment) && self.deferred.is_none() {
+            // A rest holds until the speech returns, played to and fro (see crate::follow).
+            if !self.player.backward() && self.player.at_end(self.lib) {
+                self.player.turn();
+            }
+            return;
+        }
         let t = self.timing;
         if let Some((c, f, waited)) = self.deferred {
             if self.hands_pause(segment, played) || self.ticks_reach_ms(waited + 1, t.defer_cut_ms)
@@ -743,9 +796,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             }
             return;
         }
-        // A waiting label decides at the next exit point, onset or not.
+        // A waiting label decides at the next exit point, onset or not; so does every exit
+        // point while resting (no onset is coming).
         let fresh = !t.sync_to_onsets
             || self.label_waiting()
+            || self.voice.resting()
             || self
                 .last_onset
                 .is_some_and(|o| !self.ticks_reach_ms(tick.saturating_sub(o), t.onset_window_ms));
@@ -846,8 +901,49 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         self.exit = x;
     }
 
-    /// Decides at exit `e` and acts on it.
+    /// Acts on what just changed in the voice (see [`crate::follow`]): when resting begins
+    /// (and the playing segment is not one of the calmest) or the speech returns after a rest,
+    /// decides at once at the exit point the controller is at or heading for; returns whether
+    /// it did.
+    fn follow_voice(
+        &mut self,
+        segment: usize,
+        tick: u64,
+        sink: &mut impl FnMut(ControllerEvent<'_>),
+    ) -> bool {
+        let Some(change) = self.voice.take_change() else {
+            return false;
+        };
+        if self.label_waiting() || (change == VoiceChange::Rest && self.rest.contains(segment)) {
+            return false;
+        }
+        // A cut still waiting for the hands was decided for the speech: decide again.
+        self.deferred = None;
+        let (e, reached) = match self.waiting.take() {
+            Some(e) => (e, true),
+            None => (self.exit, false),
+        };
+        self.waited = 0;
+        self.decide_with(e, tick, reached, change == VoiceChange::Rest, sink);
+        true
+    }
+
+    /// Decides at exit `e` (reached) and acts on it, a mid-segment cut waiting for the hands.
     fn decide(&mut self, e: usize, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        self.decide_with(e, tick, true, true, sink);
+    }
+
+    /// Decides at exit `e` and acts on it: `reached` whether the playback has come to `e`
+    /// (choosing to continue at one not yet reached leaves it the next exit point), `defer`
+    /// whether a mid-segment cut waits for the hands to pause.
+    fn decide_with(
+        &mut self,
+        e: usize,
+        tick: u64,
+        reached: bool,
+        defer: bool,
+        sink: &mut impl FnMut(ControllerEvent<'_>),
+    ) {
         let now = tick.min(u32::MAX as u64) as u32;
         let penalties = Penalties::new(
             &self.variety,
@@ -855,6 +951,14 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             now,
             self.ms_ticks(self.variety.recency_ms),
             self.ms_ticks(self.variety.usage_ms),
+        )
+        .with_voice(
+            self.voice.weight(&self.follow),
+            if self.voice.resting() {
+                self.rest.segments()
+            } else {
+                &[]
+            },
         );
         let s = self.tables.states();
         let b = match &self.held_belief {
@@ -868,7 +972,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         };
         match decision.choice {
             Choice::Continue => {
-                if e + 1 < self.tables.exit_count() {
+                if reached && e + 1 < self.tables.exit_count() {
                     self.exit = e + 1;
                 }
             }
@@ -900,7 +1004,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                 } else {
                     self.player.frame().saturating_sub(1)
                 };
-                let defer = !seamless
+                let defer = defer
+                    && !seamless
                     && waiting.is_none()
                     && self.timing.defer_cut_ms > 0
                     && !self.hands_pause(self.player.segment(), shown);

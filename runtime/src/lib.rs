@@ -30,6 +30,8 @@
 //! - [`policy`]: the choice of the next segment at an exit point from the belief, with the
 //!   variety costs, the user's style (tone weights mixing the value tables) and, while a
 //!   semantic label waits, the label's tables and entries before its stroke.
+//! - [`follow`]: the body follows the voice: rest in the pauses, start with the speech, an
+//!   energy weight per decision from the voice's loudness.
 //! - [`player`]: segment playback as rig poses with a short blend at cuts.
 //! - [`controller`]: samples in, poses out: front-end, belief, decisions and playback on one
 //!   sample clock; built from a validated blob.
@@ -50,6 +52,7 @@ extern crate alloc;
 pub mod blob;
 pub mod controller;
 pub mod device;
+pub mod follow;
 pub mod inference;
 #[cfg(feature = "pca9685")]
 pub mod pca9685;

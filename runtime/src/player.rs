@@ -29,6 +29,11 @@
 //! after it (its recorded successor) without a cut, so the body keeps moving while the
 //! controller waits for a syllable onset.
 //!
+//! **Playback rate.** [`Player::set_rate`] slows playback down to [`MIN_RATE`] (half the
+//! library's pace), interpolating between frames: the controller plays a calm segment slower
+//! while the character rests if the segment moves faster than a rest should
+//! ([`crate::follow::rest_rate`]).
+//!
 //! Invariants: fixed memory (a few arrays of [`MAX_CHANNELS`] values), no allocation, no panics;
 //! every output value is finite (non-finite library values are replaced by the previous
 //! output, non-finite offsets by none).
@@ -47,6 +52,13 @@ const SETTLE: f32 = 6.64;
 /// The longest a cut's blend is stretched to keep the offset within the speed cap, as a
 /// multiple of the set blend time.
 pub const MAX_BLEND_STRETCH: u32 = 3;
+
+/// The slowest playback rate (frames per tick): half the library's pace. Calm motion at half
+/// speed still reads as breathing and drift; slower, it reads as slow motion.
+pub const MIN_RATE: f32 = 0.5;
+
+/// A phase this close to a whole frame counts as one (so a rate of 1 never interpolates).
+const RATE_EPSILON: f32 = 1.0e-4;
 
 /// Bins of the histogram behind [`library_speed_cap`].
 const SPEED_BINS: usize = 128;
@@ -158,6 +170,12 @@ pub struct Player {
     /// Fastest the offset may move (degrees per tick at its start; 0: no cap).
     speed_cap: f32,
     blending: bool,
+    /// Frames advanced per tick ([`MIN_RATE`]..=1).
+    rate: f32,
+    /// How far playback stands between `frame` and the next frame (0..1).
+    phase: f32,
+    /// Playing the segment backwards (see [`Player::turn`]).
+    backward: bool,
 }
 
 impl Player {
@@ -177,7 +195,39 @@ impl Player {
             cut_ticks: 0,
             speed_cap: 0.0,
             blending: false,
+            rate: 1.0,
+            phase: 0.0,
+            backward: false,
         }
+    }
+
+    /// Turns playback around: from a segment's last frame it plays back towards its first,
+    /// where it turns forward again by itself (a rest played to and fro at its own pace, with
+    /// no cut). Entering a segment plays it forward.
+    pub fn turn(&mut self) {
+        self.backward = !self.backward;
+    }
+
+    /// Whether the segment is played backwards.
+    pub fn backward(&self) -> bool {
+        self.backward
+    }
+
+    /// Plays `rate` frames per tick from the next tick on, clamped to [`MIN_RATE`]..=1 (1:
+    /// the library's own pace; a non-finite rate is 1). Between frames the pose is
+    /// interpolated linearly (a channel whose two frames are more than 180 degrees apart, a
+    /// wrap, holds the earlier frame), so slower playback stays smooth.
+    pub fn set_rate(&mut self, rate: f32) {
+        self.rate = if rate.is_finite() {
+            rate.clamp(MIN_RATE, 1.0)
+        } else {
+            1.0
+        };
+    }
+
+    /// Frames advanced per tick.
+    pub fn rate(&self) -> f32 {
+        self.rate
     }
 
     /// Cuts blend over `ticks` animation ticks (0: hard cuts).
@@ -218,6 +268,8 @@ impl Player {
         if lib.continues(self.segment) && self.segment + 1 < lib.segment_count() {
             self.segment += 1;
             self.frame = 0;
+            self.phase = 0.0;
+            self.backward = false;
         }
     }
 
@@ -233,6 +285,8 @@ impl Player {
         let f = f.min(len - 1);
         self.segment = c;
         self.frame = f;
+        self.phase = 0.0;
+        self.backward = false;
         self.since = 0;
         self.cut_ticks = self.blend_ticks;
         self.blending = self.blend_ticks > 0 && self.outputs > 0;
@@ -353,6 +407,14 @@ impl Player {
         for (ch, o) in out.iter_mut().enumerate().take(n) {
             *o = self.target(lib, c, f, ch);
         }
+        if self.phase > 0.0 && f + 1 < len {
+            for (ch, o) in out.iter_mut().enumerate().take(n) {
+                let d = self.target(lib, c, f + 1, ch) - *o;
+                if d.abs() <= 180.0 {
+                    *o += self.phase * d;
+                }
+            }
+        }
         if self.blending && self.since >= self.cut_ticks {
             self.blending = false;
         }
@@ -395,8 +457,25 @@ impl Player {
             self.last[ch] = *o;
         }
         self.outputs = self.outputs.saturating_add(1);
-        if advance && self.frame + 1 < len {
-            self.frame += 1;
+        if advance {
+            // Frame counts stay far below 2^24, so the position is exact in f32.
+            let last = (len - 1) as f32;
+            let here = self.frame.min(len - 1) as f32 + self.phase;
+            let mut to = if self.backward {
+                here - self.rate
+            } else {
+                here + self.rate
+            };
+            if to <= RATE_EPSILON {
+                to = 0.0;
+                self.backward = false;
+            }
+            if to >= last - RATE_EPSILON {
+                to = last;
+            }
+            let whole = libm::floorf(to + RATE_EPSILON);
+            self.frame = (whole as usize).min(len - 1);
+            self.phase = (to - whole).max(0.0);
         }
         f
     }
@@ -509,6 +588,46 @@ mod tests {
         fn value(&self, c: usize, f: usize, _: usize) -> f32 {
             (self.f)(c, f)
         }
+    }
+
+    #[test]
+    fn a_slower_rate_interpolates_and_a_turn_plays_back_to_the_start() {
+        let lib = FnLib {
+            segs: 1,
+            len: 5,
+            f: |_, f| 10.0 * f as f32,
+        };
+        let mut p = Player::new();
+        let mut out = [0.0; MAX_CHANNELS];
+        let mut play = |p: &mut Player| {
+            let mut v = [0.0f32; 9];
+            for x in v.iter_mut() {
+                p.tick(&lib, &mut out);
+                *x = out[0];
+            }
+            v
+        };
+        p.set_rate(0.5);
+        let poses = play(&mut p);
+        // Half a frame per tick, linearly between frames, up to the last frame.
+        assert_eq!(poses, [0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 35.0, 40.0]);
+        assert!(p.at_end(&lib) && !p.backward());
+        p.turn();
+        let back = play(&mut p);
+        assert_eq!(back, [40.0, 35.0, 30.0, 25.0, 20.0, 15.0, 10.0, 5.0, 0.0]);
+        // At the first frame it turns forward by itself.
+        assert!(!p.backward());
+        assert_eq!(play(&mut p)[..2], [0.0, 5.0]);
+        // Rates are clamped to MIN_RATE..=1; a non-finite one is 1. Entering plays forward.
+        p.set_rate(0.1);
+        assert_eq!(p.rate(), MIN_RATE);
+        p.set_rate(f32::NAN);
+        assert_eq!(p.rate(), 1.0);
+        p.turn();
+        p.enter(&lib, 0);
+        assert!(!p.backward());
+        // At rate 1 playback is frame by frame, never between frames.
+        assert_eq!(play(&mut p)[..5], [0.0, 10.0, 20.0, 30.0, 40.0]);
     }
 
     #[test]

@@ -39,6 +39,8 @@
 
 use heapless::HistoryBuffer;
 
+use crate::follow::REST_SET;
+
 /// The policy tables as the selector needs them. Implementations must only be built from
 /// validated data: every method is called with indices in range.
 pub trait PolicyTables {
@@ -135,6 +137,11 @@ pub trait PolicyTables {
     /// The entry from exit `e` into the `k`-th labelled segment: `(frame, cost)`.
     fn entry(&self, _e: usize, _k: usize) -> (usize, f32) {
         (0, f32::INFINITY)
+    }
+    /// Segment `c`'s energy (the log of its hands' mean speed over the library's median; 0:
+    /// every segment alike), weighed by the voice ([`crate::follow`]).
+    fn energy(&self, _c: usize) -> f32 {
+        0.0
     }
     /// `U^m(c, s)` of tone `m < tones()`.
     fn tone_u(&self, _m: usize, c: usize, s: usize) -> f32 {
@@ -371,6 +378,11 @@ pub struct Penalties {
     cost: [f32; HISTORY],
     usage: [f32; HISTORY],
     len: usize,
+    /// Cost per unit of a candidate's energy ([`crate::follow`]).
+    energy_weight: f32,
+    /// Candidates beside the exit's successors (the rest segments while resting).
+    extra: [u16; REST_SET],
+    extra_len: usize,
 }
 
 impl Penalties {
@@ -380,7 +392,30 @@ impl Penalties {
         cost: [0.0; HISTORY],
         usage: [0.0; HISTORY],
         len: 0,
+        energy_weight: 0.0,
+        extra: [0; REST_SET],
+        extra_len: 0,
     };
+
+    /// The same penalties with every candidate charged `weight` times its energy (continuing
+    /// too), and the segments `extra` (at most [`REST_SET`]) candidates at every exit point
+    /// beside its successors, at the largest successor cost of that exit.
+    pub fn with_voice(mut self, weight: f32, extra: &[u16]) -> Self {
+        self.energy_weight = if weight.is_finite() { weight } else { 0.0 };
+        let n = extra.len().min(REST_SET);
+        self.extra[..n].copy_from_slice(&extra[..n]);
+        self.extra_len = n;
+        self
+    }
+
+    /// The energy term of segment `c`.
+    fn energy<T: PolicyTables + ?Sized>(&self, t: &T, c: usize) -> f32 {
+        if self.energy_weight == 0.0 {
+            0.0
+        } else {
+            self.energy_weight * t.energy(c)
+        }
+    }
 
     /// The penalties at tick `now` given `history` and the windows in ticks (`recency_ticks`,
     /// `usage_ticks`; 0 disables a term).
@@ -483,12 +518,24 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
         entry_frame: 0,
     };
     if !t.exit_is_end(e) {
-        best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(t.exit_segment(e));
+        let a = t.exit_segment(e);
+        best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(a) + penalty.energy(t, a);
         best.candidates = 1;
     }
+    let mut worst_junction = 0.0f32;
     for k in 0..t.successor_count(e) {
         let (c, sc) = t.successor(e, k);
-        let v = sc + style.u_dot(t, c, b) + penalty.of(c);
+        worst_junction = worst_junction.max(sc);
+        let v = sc + style.u_dot(t, c, b) + penalty.of(c) + penalty.energy(t, c);
+        best.candidates += 1;
+        if v < best.cost {
+            best.cost = v;
+            best.choice = Choice::Enter(c);
+        }
+    }
+    for &c in &penalty.extra[..penalty.extra_len] {
+        let c = c as usize;
+        let v = worst_junction + style.u_dot(t, c, b) + penalty.of(c) + penalty.energy(t, c);
         best.candidates += 1;
         if v < best.cost {
             best.cost = v;

@@ -313,6 +313,14 @@ fn every_error_variant_is_reachable() {
         },
     );
     check(
+        &mutated(&|t| t.energy = vec![0]),
+        BlobError::TableLength {
+            field: Field::Energy,
+            expected: 2,
+            found: 1,
+        },
+    );
+    check(
         &mutated(&|t| t.groups = vec![0, 0]),
         BlobError::TableLength {
             field: Field::Groups,
@@ -520,6 +528,26 @@ fn every_error_variant_is_reachable() {
             field: Field::DeferCut,
         },
     );
+    check(
+        &mutated(&|t| t.control.rest_ms = 10_001),
+        BlobError::BadControl {
+            field: Field::RestAfter,
+        },
+    );
+    for bad in [-1.0, f32::NAN, f32::INFINITY, 2.0e6] {
+        check(
+            &mutated(&|t| t.control.rest_cost = bad),
+            BlobError::BadControl {
+                field: Field::RestCost,
+            },
+        );
+        check(
+            &mutated(&|t| t.control.energy_cost = bad),
+            BlobError::BadControl {
+                field: Field::EnergyCost,
+            },
+        );
+    }
 
     // skeleton.
     let sk = |f: &dyn Fn(&mut TinySkeleton)| {

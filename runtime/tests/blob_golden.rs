@@ -112,7 +112,7 @@ fn golden_bytes_and_round_trip() {
     );
     assert_eq!(blob.successors(3).len(), 0);
     // control
-    assert_eq!(sz.control, 23);
+    assert_eq!(sz.control, 33);
     let t = blob.timing();
     assert_eq!(
         (
@@ -130,6 +130,8 @@ fn golden_bytes_and_round_trip() {
         (1.5, 5000, 4.0, 30000)
     );
     assert_eq!(blob.blend_ms(), 250);
+    let f = blob.follow();
+    assert_eq!((f.rest_ms, f.rest_cost, f.energy_cost), (750, 2.5, 1.5));
     // library
     assert_eq!((blob.channels(), blob.frames(), blob.fps()), (1, 6, 30.0));
     assert_eq!(
@@ -149,6 +151,11 @@ fn golden_bytes_and_round_trip() {
     assert_eq!(beats, [1, 4]);
     let calm: Vec<usize> = (0..8).filter(|&f| blob.is_calm_frame(f)).collect();
     assert_eq!(calm, [0, 5]);
+    assert_eq!(
+        (blob.segment_energy(0), blob.segment_energy(1)),
+        (-1.0, 1.5)
+    );
+    assert_eq!(blob.segment_energy(2), 0.0);
     assert_eq!((blob.group_count(), blob.group(0)), (0, None));
     assert!((blob.frame(0, 3) - 13.0).abs() < 1e-5);
     assert!((blob.segment_value(1, 2, 0) - 8.0).abs() < 1e-5);

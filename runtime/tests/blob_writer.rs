@@ -5,6 +5,7 @@
 use gesture_runtime::blob::encode::*;
 use gesture_runtime::blob::{Blob, BlobError, ControlSection, FrontEndSection};
 use gesture_runtime::controller::DecisionTiming;
+use gesture_runtime::follow::VoiceFollow;
 use gesture_runtime::inference::GmmComponent;
 use gesture_runtime::policy::Variety;
 use gesture_runtime::prosody::ProsodyConfig;
@@ -61,7 +62,8 @@ fn constructors_round_trip_through_the_reader() {
     // Channels 0..3 hold one rotation (Z, Y, X: EULER_ORDERS index 5).
     let library = OwnedLibrary::new(25.0, 3, &frames, &segs, &[3, 17], &[(0, 5)])
         .unwrap()
-        .with_calm(&[0, 9, 19, 20]);
+        .with_calm(&[0, 9, 19, 20])
+        .with_energy(&[-1.0, 0.03, 2.5, 100.0]);
     // Exits: an interruption at frame 2 of every segment and the end at frame 4.
     let exits: Vec<(usize, usize)> = (0..4).flat_map(|s| [(s, 2), (s, 4)]).collect();
     // End exits: two successors sorted by segment; interruptions: none.
@@ -108,11 +110,16 @@ fn constructors_round_trip_through_the_reader() {
         usage_cost: 3.0,
         usage_ms: 20000,
     };
+    let follow = VoiceFollow {
+        rest_ms: 600,
+        rest_cost: 3.5,
+        energy_cost: 0.75,
+    };
     let owned = OwnedPayload {
         front_end: FrontEndSection::from_config(&ProsodyConfig::DEFAULT),
         inference,
         policy,
-        control: ControlSection::new(&timing, &variety, 200),
+        control: ControlSection::new(&timing, &variety, &follow, 200),
         library,
         rig,
         skeleton: None,
@@ -138,6 +145,7 @@ fn constructors_round_trip_through_the_reader() {
     near(b.crf_weights().init.get(2), 0.3, 0.3);
     assert_eq!(b.timing(), timing);
     assert_eq!(b.variety(), variety);
+    assert_eq!(b.follow(), follow);
     assert_eq!(b.blend_ms(), 200);
     assert!(b.continues(0) && b.continues(2) && !b.continues(3));
     let beats: Vec<usize> = (0..20).filter(|&f| b.is_beat_frame(f)).collect();
@@ -145,6 +153,9 @@ fn constructors_round_trip_through_the_reader() {
     // Calm frames as given; one past the frame table is dropped.
     let calm: Vec<usize> = (0..24).filter(|&f| b.is_calm_frame(f)).collect();
     assert_eq!(calm, [0, 9, 19]);
+    // Energies in steps of 1/16, saturating at the i8's range.
+    let energy: Vec<f32> = (0..4).map(|c| b.segment_energy(c)).collect();
+    assert_eq!(energy, [-1.0, 0.0, 2.5, 127.0 / 16.0]);
     assert_eq!((b.group_count(), b.group(0)), (1, Some((0, [2, 1, 0]))));
     // Frames come back within half a quantization step of each channel's range.
     for (f, fr) in frames.iter().enumerate() {

@@ -18,6 +18,7 @@ use super::records::{calibration_record, gmm_from_record, gmm_record};
 use super::skeleton::{BvhChannel, Drive};
 use super::{Blob, BlobError, Header};
 use crate::controller::DecisionTiming;
+use crate::follow::VoiceFollow;
 use crate::inference::{CrfWeights, GmmComponent, I16Table};
 use crate::policy::Variety;
 use crate::prosody::ProsodyConfig;
@@ -372,6 +373,8 @@ pub struct OwnedLibrary {
     pub beats: Vec<u8>,
     /// Calm bitset over the frame table.
     pub calm: Vec<u8>,
+    /// `i8` energy per segment.
+    pub energy: Vec<u8>,
     /// Rotation-group records.
     pub groups: Vec<u8>,
 }
@@ -403,6 +406,7 @@ impl OwnedLibrary {
             continues: &self.continues,
             beats: &self.beats,
             calm: &self.calm,
+            energy: &self.energy,
             groups: &self.groups,
         }
     }
@@ -411,6 +415,21 @@ impl OwnedLibrary {
     /// default) marked calm (the hands slow: where a deferred cut may fall).
     pub fn with_calm(mut self, calm: &[usize]) -> Self {
         self.calm = frame_bits(self.frames as usize, calm);
+        self
+    }
+
+    /// The same library with each segment's energy (the log of its hands' mean speed over the
+    /// library's median frame speed; 0 for all by default, a missing one 0) quantized to an
+    /// `i8` in steps of 1/[`ENERGY_SCALE`](super::ENERGY_SCALE), saturating.
+    pub fn with_energy(mut self, energy: &[f32]) -> Self {
+        for (q, &e) in self.energy.iter_mut().zip(energy) {
+            let v = if e.is_finite() {
+                e * super::ENERGY_SCALE
+            } else {
+                0.0
+            };
+            *q = (libm::roundf(v).clamp(-127.0, 127.0) as i8) as u8;
+        }
         self
     }
 
@@ -480,6 +499,7 @@ impl OwnedLibrary {
             continues: segments.iter().map(|s| s.continues as u8).collect(),
             beats: frame_bits(frames.len(), beats),
             calm: frame_bits(frames.len(), &[]),
+            energy: alloc::vec![0u8; segments.len()],
             groups: groups
                 .iter()
                 .map(|&(first, order)| {
@@ -902,7 +922,12 @@ impl OwnedPayload {
                 front_end: FrontEndSection::from_config(&ProsodyConfig::DEFAULT),
                 inference,
                 policy,
-                control: ControlSection::new(&DecisionTiming::DEFAULT, &Variety::NONE, 0),
+                control: ControlSection::new(
+                    &DecisionTiming::DEFAULT,
+                    &Variety::NONE,
+                    &VoiceFollow::NONE,
+                    0,
+                ),
                 library,
                 rig,
                 skeleton: None,

@@ -99,6 +99,12 @@ pub enum Field {
     BeatHold,
     /// `control.defer_cut_ms`.
     DeferCut,
+    /// `control.rest_ms`.
+    RestAfter,
+    /// `control.rest_cost`.
+    RestCost,
+    /// `control.energy_cost`.
+    EnergyCost,
     /// `library.channels`.
     Channels,
     /// `library.frames`.
@@ -121,6 +127,8 @@ pub enum Field {
     Beats,
     /// `library.calm`.
     Calm,
+    /// `library.energy`.
+    Energy,
     /// `library.groups`.
     Groups,
     /// `rig.calibration`.
@@ -189,6 +197,9 @@ impl Field {
             Self::Blend => "control.blend_ms",
             Self::BeatHold => "control.beat_hold_ms",
             Self::DeferCut => "control.defer_cut_ms",
+            Self::RestAfter => "control.rest_ms",
+            Self::RestCost => "control.rest_cost",
+            Self::EnergyCost => "control.energy_cost",
             Self::Channels => "library.channels",
             Self::Frames => "library.frames",
             Self::SegStart => "library.seg_start",
@@ -200,6 +211,7 @@ impl Field {
             Self::Continues => "library.continues",
             Self::Beats => "library.beats",
             Self::Calm => "library.calm",
+            Self::Energy => "library.energy",
             Self::Groups => "library.groups",
             Self::Calibration => "rig.calibration",
             Self::Joints => "skeleton.joints",

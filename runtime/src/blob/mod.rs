@@ -90,3 +90,8 @@ pub const MAX_BLEND_MS: u16 = 5000;
 pub const MAX_BEAT_HOLD_MS: u16 = 1000;
 /// Longest delay of a cut until the hands pause, of the `control` section (ms).
 pub const MAX_DEFER_CUT_MS: u16 = 1000;
+/// Longest silence before resting, of the `control` section (ms).
+pub const MAX_REST_MS: u16 = 10_000;
+/// `library.energy` holds a segment's energy times this, rounded (an `i8`: energies within
+/// +-8, a 1/16 step).
+pub const ENERGY_SCALE: f32 = 16.0;

@@ -286,14 +286,21 @@ pub struct ControlSection {
     pub beat_hold_ms: u16,
     /// Longest delay of a cut decided mid-segment until the hands pause (ms; 0: cut at once).
     pub defer_cut_ms: u16,
+    /// Silence (ms) after which the character rests ([`VoiceFollow::rest_ms`](crate::follow::VoiceFollow::rest_ms); 0: never).
+    pub rest_ms: u16,
+    /// Cost per unit of segment energy while resting (cost units, >= 0).
+    pub rest_cost: f32,
+    /// Cost per unit of segment energy and voice level while speaking (cost units, >= 0).
+    pub energy_cost: f32,
 }
 
 impl ControlSection {
-    /// The section for timing `t`, variety `v` and blend time `blend_ms` (durations saturate
+    /// The section for timing `t`, variety `v`, following the voice `f` and blend time `blend_ms` (durations saturate
     /// at `u16::MAX`).
     pub fn new(
         t: &crate::controller::DecisionTiming,
         v: &crate::policy::Variety,
+        f: &crate::follow::VoiceFollow,
         blend_ms: u32,
     ) -> Self {
         let ms = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
@@ -308,6 +315,9 @@ impl ControlSection {
             blend_ms: ms(blend_ms),
             beat_hold_ms: ms(t.beat_hold_ms),
             defer_cut_ms: ms(t.defer_cut_ms),
+            rest_ms: ms(f.rest_ms),
+            rest_cost: f.rest_cost,
+            energy_cost: f.energy_cost,
         }
     }
 }
@@ -354,6 +364,11 @@ pub struct LibrarySection<'a> {
     /// fall on a calm frame or a beat ([`DecisionTiming::defer_cut_ms`](crate::controller::DecisionTiming::defer_cut_ms)).
     #[serde(borrow)]
     pub calm: &'a [u8],
+    /// `i8` per segment: its energy, the log of its hands' mean speed over the library's
+    /// median frame speed, in units of 1/[`ENERGY_SCALE`](super::ENERGY_SCALE)
+    /// ([`crate::follow`]).
+    #[serde(borrow)]
+    pub energy: &'a [u8],
     /// Rotation groups: records `{first: u16, order: u8}`, three channels
     /// `first..first + 3` holding one joint rotation as Euler angles in that order
     /// ([`EULER_ORDERS`](super::EULER_ORDERS) index), blended as rotations; sorted, disjoint.

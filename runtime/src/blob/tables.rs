@@ -85,6 +85,9 @@ impl PolicyTables for Blob<'_> {
     fn tone_u_cont(&self, m: usize, e: usize, s: usize) -> f32 {
         Blob::tone_u_cont(self, m, e, s)
     }
+    fn energy(&self, c: usize) -> f32 {
+        self.segment_energy(c)
+    }
 }
 
 impl LibraryFrames for Blob<'_> {

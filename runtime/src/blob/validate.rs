@@ -10,7 +10,7 @@ use super::records::{calibration_from_record, f32_at, record, u16_at, u32_at};
 use super::skeleton::{Drive, MAX_JOINTS};
 use super::{
     MAX_BEAT_HOLD_MS, MAX_BLEND_MS, MAX_CHANNELS, MAX_DEFER_CUT_MS, MAX_EXITS, MAX_FPS, MAX_FRAMES,
-    MAX_ONSET_WINDOW_MS, MAX_SEGMENTS, MAX_VARIETY_COST, MAX_WAIT_MS,
+    MAX_ONSET_WINDOW_MS, MAX_REST_MS, MAX_SEGMENTS, MAX_VARIETY_COST, MAX_WAIT_MS,
 };
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
 use crate::rig::validate_period;
@@ -290,6 +290,7 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
     length(Field::Continues, l.continues, segs, 1)?;
     length(Field::Beats, l.beats, frames.div_ceil(8), 1)?;
     length(Field::Calm, l.calm, frames.div_ceil(8), 1)?;
+    length(Field::Energy, l.energy, segs, 1)?;
     if l.groups.len() % GROUP_RECORD_BYTES != 0 {
         return Err(BlobError::TableLength {
             field: Field::Groups,
@@ -542,6 +543,15 @@ fn control(c: &ControlSection) -> Result<(), BlobError> {
     }
     if c.defer_cut_ms > MAX_DEFER_CUT_MS {
         return bad(Field::DeferCut);
+    }
+    if c.rest_ms > MAX_REST_MS {
+        return bad(Field::RestAfter);
+    }
+    if !cost_ok(c.rest_cost) {
+        return bad(Field::RestCost);
+    }
+    if !cost_ok(c.energy_cost) {
+        return bad(Field::EnergyCost);
     }
     Ok(())
 }

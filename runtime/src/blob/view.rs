@@ -16,6 +16,7 @@ use super::records::{
 use super::skeleton::SkeletonView;
 use super::validate;
 use crate::controller::DecisionTiming;
+use crate::follow::VoiceFollow;
 use crate::inference::{CrfWeights, GmmComponent, I16Table, MAX_CLUSTERS};
 use crate::policy::Variety;
 #[cfg(doc)]
@@ -394,6 +395,16 @@ impl<'a> Blob<'a> {
         }
     }
 
+    /// How the character follows the voice (the `control` section).
+    pub fn follow(&self) -> VoiceFollow {
+        let c = &self.payload.control;
+        VoiceFollow {
+            rest_ms: c.rest_ms as u32,
+            rest_cost: c.rest_cost,
+            energy_cost: c.energy_cost,
+        }
+    }
+
     /// How the controller varies its choices (the `control` section).
     pub fn variety(&self) -> Variety {
         let c = &self.payload.control;
@@ -453,6 +464,15 @@ impl<'a> Blob<'a> {
     /// Whether frame `f` of the frame table is calm (false out of range).
     pub fn is_calm_frame(&self, f: usize) -> bool {
         frame_bit(self.payload.library.calm, f)
+    }
+
+    /// Segment `s`'s energy (`library.energy`; 0 out of range).
+    pub fn segment_energy(&self, s: usize) -> f32 {
+        self.payload
+            .library
+            .energy
+            .get(s)
+            .map_or(0.0, |&q| q as i8 as f32 / super::ENERGY_SCALE)
     }
 
     /// Rotation groups (records of `library.groups`).

@@ -238,6 +238,17 @@ pub struct DeviceArgs {
     /// Usage window (ms).
     #[arg(long, default_value_t = crate::pack::DEFAULT_VARIETY.usage_ms, value_parser = clap::value_parser!(u32).range(0..=u16::MAX as i64))]
     pub usage_ms: u32,
+    /// Silence (ms) after which the character rests, moving to the library's calmest
+    /// segments (0: never rests).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_FOLLOW.rest_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_REST_MS as i64))]
+    pub rest_ms: u32,
+    /// Cost per unit of a segment's energy while resting (0: no rest).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_FOLLOW.rest_cost, value_parser = cost_f32)]
+    pub rest_cost: f32,
+    /// Cost per unit of a segment's energy at full voice level while speaking: louder speech
+    /// favours energetic segments, quieter calm ones (0: off).
+    #[arg(long, default_value_t = crate::pack::DEFAULT_FOLLOW.energy_cost, value_parser = cost_f32)]
+    pub energy_cost: f32,
     /// Inertialization time at cuts (ms; 0: hard cuts).
     #[arg(long, default_value_t = crate::pack::DEFAULT_BLEND_MS, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_BLEND_MS as i64))]
     pub blend_ms: u32,
@@ -253,6 +264,8 @@ impl DeviceArgs {
         for (name, v) in [
             ("--recency-cost", self.recency_cost),
             ("--usage-cost", self.usage_cost),
+            ("--rest-cost", self.rest_cost),
+            ("--energy-cost", self.energy_cost),
         ] {
             if !(v.is_finite() && (0.0..=1.0e6).contains(&v)) {
                 return Err(format!("{name} must be a number from 0 to 1e6, not {v}").into());
@@ -266,6 +279,7 @@ impl DeviceArgs {
             ("--max-wait-ms", self.max_wait_ms, 5_000),
             ("--beat-hold-ms", self.beat_hold_ms, 1_000),
             ("--defer-cut-ms", self.defer_cut_ms, 1_000),
+            ("--rest-ms", self.rest_ms, 10_000),
         ] {
             if v > max {
                 return Err(format!("{name} must be at most {max}, not {v}").into());
@@ -292,6 +306,11 @@ impl DeviceArgs {
             recency_ms: self.recency_ms,
             usage_cost: self.usage_cost,
             usage_ms: self.usage_ms,
+        };
+        opts.follow = gesture_runtime::follow::VoiceFollow {
+            rest_ms: self.rest_ms,
+            rest_cost: self.rest_cost,
+            energy_cost: self.energy_cost,
         };
         opts.blend_ms = self.blend_ms;
         opts.plant_feet = !self.free_legs;

@@ -86,6 +86,37 @@ pub fn summary(b: &Blob<'_>) -> String {
         b.blend_ms(),
         t.beat_hold_ms
     );
+    let f = b.follow();
+    let _ = writeln!(
+        s,
+        "voice: {}; energy cost {} at full voice level",
+        if f.rest_ms > 0 && f.rest_cost > 0.0 {
+            format!(
+                "rests after {} ms of silence (cost {} per unit of energy)",
+                f.rest_ms, f.rest_cost
+            )
+        } else {
+            "never rests".to_string()
+        },
+        f.energy_cost
+    );
+    let rest = gesture_runtime::follow::RestSet::of(b, b.segments());
+    let energies: Vec<f32> = (0..b.segments()).map(|c| b.segment_energy(c)).collect();
+    let _ = writeln!(
+        s,
+        "segment energy (ln of mean hand speed over the median): {:.2} to {:.2}; calmest: {}",
+        energies.iter().copied().fold(f32::INFINITY, f32::min),
+        energies.iter().copied().fold(f32::NEG_INFINITY, f32::max),
+        rest.segments()
+            .iter()
+            .map(|&c| format!(
+                "{c} ({:.2}, {} frames)",
+                b.segment_energy(c as usize),
+                b.segment(c as usize).map_or(0, |x| x.len)
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
     let continued = (0..b.segments()).filter(|&i| b.continues(i)).count();
     let _ = writeln!(
         s,

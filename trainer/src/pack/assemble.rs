@@ -70,6 +70,32 @@ pub fn calm_frames(takes: &[(usize, Vec<f64>)]) -> Vec<usize> {
         .collect()
 }
 
+/// Each segment's energy (`library.energy`, read by `gesture_runtime::follow`): the natural
+/// log of its hands' mean smoothed speed over the median smoothed speed of all the takes'
+/// frames. `takes` as for [`calm_frames`], `segments` as (take, first frame, end frame) in
+/// the take. A segment without frames, or a library that never moves, has energy 0; a
+/// segment that stands still is floored at 1/100 of the median (`ln = -4.6`).
+pub fn segment_energies(
+    takes: &[(usize, Vec<f64>)],
+    segments: &[(usize, usize, usize)],
+) -> Vec<f32> {
+    let all: Vec<f64> = takes.iter().flat_map(|(_, s)| s.iter().copied()).collect();
+    let median = quantile(&all, 0.5);
+    segments
+        .iter()
+        .map(|&(take, a, b)| {
+            let sp = takes
+                .get(take)
+                .map_or(&[][..], |(_, s)| &s[a.min(s.len())..b.min(s.len())]);
+            if sp.is_empty() || median <= 0.0 {
+                return 0.0;
+            }
+            let mean = sp.iter().sum::<f64>() / sp.len() as f64;
+            (mean.max(0.01 * median) / median).ln() as f32
+        })
+        .collect()
+}
+
 /// The sections of `lib` through `rig` (the takes must share a skeleton); also returns the
 /// number of frames stored.
 pub fn parts(
@@ -141,12 +167,19 @@ pub fn parts(
         Some(OwnedSkeleton::new(&joint_specs(sk), &rest, &drives)?)
     };
     let calm = calm_frames(&speeds);
+    let energy = segment_energies(
+        &speeds,
+        &lib.segments
+            .iter()
+            .map(|s| (s.take, s.start, s.end))
+            .collect::<Vec<_>>(),
+    );
     let n = frames.len();
     Ok((
         Parts {
             front_end: FrontEndSection::from_config(&config),
             inference: inference_section(&model.gmm, &model.crf)?,
-            control: ControlSection::new(&opts.timing, &opts.variety, opts.blend_ms),
+            control: ControlSection::new(&opts.timing, &opts.variety, &opts.follow, opts.blend_ms),
             library: OwnedLibrary::new(
                 lib.fps,
                 rig.channels.len(),
@@ -159,7 +192,8 @@ pub fn parts(
                     &lib.takes[0].source.display().to_string(),
                 )?,
             )?
-            .with_calm(&calm),
+            .with_calm(&calm)
+            .with_energy(&energy),
             rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
             skeleton,
         },

@@ -34,6 +34,7 @@ use std::time::Instant;
 use gesture_runtime::blob::encode::EncodeError;
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::DecisionTiming;
+use gesture_runtime::follow::VoiceFollow;
 use gesture_runtime::policy::{Style, Variety};
 use serde::Serialize;
 
@@ -65,6 +66,13 @@ pub const DEFAULT_VARIETY: Variety = Variety {
     usage_ms: 45000,
 };
 
+/// How a blob follows the voice by default (see `gesture_runtime::follow`).
+pub const DEFAULT_FOLLOW: VoiceFollow = VoiceFollow {
+    rest_ms: 500,
+    rest_cost: 4.0,
+    energy_cost: 1.0,
+};
+
 /// Inertialization time at cuts a blob gets by default (ms).
 pub const DEFAULT_BLEND_MS: u32 = 400;
 
@@ -81,6 +89,8 @@ pub struct PackOptions {
     pub timing: DecisionTiming,
     /// How the device varies its choices (the blob's `control` section).
     pub variety: Variety,
+    /// How the device follows the voice (the blob's `control` section).
+    pub follow: VoiceFollow,
     /// Inertialization time at cuts (ms; the blob's `control` section).
     pub blend_ms: u32,
     /// Hold the lower body of a skeleton with legs in a standing pose (see `plant`).
@@ -116,6 +126,7 @@ impl Default for PackOptions {
             control: ControlParams::default(),
             timing: DecisionTiming::default(),
             variety: DEFAULT_VARIETY,
+            follow: DEFAULT_FOLLOW,
             blend_ms: DEFAULT_BLEND_MS,
             plant_feet: true,
             effectors: EffectorSpec::default(),

@@ -1,0 +1,339 @@
+//! The body follows the voice: rest in the pauses, start with the speech, energy with the
+//! loudness (docs/method.md, "Beyond the paper: the body follows the voice").
+//!
+//! The paper's cost of showing segment `c` under belief `b` is `b . psi_c` plus the successor
+//! cost (§6); the belief is all the controller knows of the speech. With a weak belief (two
+//! states, a third of a nat per step above the prior on the shared takes) that is not enough:
+//! the hands went on gesturing through silences at half to four fifths of their speaking speed
+//! and started late when the speech returned, because the belief needs a syllable or two to
+//! move and decisions waited for onsets that a pause does not have. Speakers rest in pauses
+//! (their hands at 4-8 % of the speaking speed in the shared takes) and start with the speech.
+//!
+//! This module adds what the voice says directly, as one more term of the decision cost, the
+//! way the style machinery (§8.2) adds a tone: an **energy weight per decision**, `w . E_c`,
+//! where `E_c` is the segment's energy (the log of its hands' mean speed over the library's
+//! median frame speed, computed by `pack`: `library.energy`) and `w` comes from the voice:
+//!
+//! - **resting** (the speech has been silent for `rest_ms`, counted in the front-end's pause
+//!   steps): `w = rest_cost`, so the calmest segments cost least. The `REST_SET` calmest
+//!   segments of the library are candidates at every exit point while resting (the pruned
+//!   successor lists need not hold one), at the largest successor cost of that exit (an entry
+//!   no better than the worst listed junction; the player's blend makes every cut seamless).
+//!   Resting, every exit point decides at once (no onset is coming) and the moment resting
+//!   begins the controller decides at the playing segment's next exit point without waiting
+//!   for it: the cut then waits, as every mid-segment cut does, for the next pause of the hands
+//!   (`defer_cut_ms`), so the playing gesture is left between strokes. The rest motion is the
+//!   library's own: its calmest segments, breathing and drifting as the capture did.
+//! - **speaking**: `w = -energy_cost * clamp(level / VOICE_SPAN, -1, 1)`, `level` the last
+//!   syllable's intensity relative to the speaker's running level (the CRF's own step feature,
+//!   in 10 dB units): louder than usual favours energetic segments, quieter calm ones.
+//! - **the speech returns** (the first onset after resting): the controller decides at once,
+//!   at the playing segment's next exit point, and cuts without waiting (the hands are at
+//!   rest, so there is no stroke to spare); the voice level counts as `+VOICE_SPAN` until the
+//!   first syllable is measured (speech out of silence is as loud as it gets relative to it).
+//!   The chosen segment is entered at its first frame: a preparation, not a stroke.
+//!
+//! - **the rest's pace**: a library with no true rest (a monologue's capture: the calmest
+//!   segments of the shared 067 take move at 0.4 of its median hand speed) would still gesture
+//!   in the pauses. While resting, a segment faster than [`REST_SPEED`] of the library's median
+//!   plays slower in proportion ([`rest_rate`]), at least at half its pace
+//!   ([`MIN_RATE`](crate::player::MIN_RATE)), interpolated between frames: a calm motion at
+//!   half speed reads as breathing and drift, not as slow motion.
+//!
+//! The belief still chooses among segments of like energy, and the variety costs still apply
+//! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
+//! `f32` on values read from the blob, the same on host and device; the state is a few bytes.
+
+use crate::policy::PolicyTables;
+
+/// How the character follows the voice (the blob's `control` section).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VoiceFollow {
+    /// Silence (ms, counted in pause steps) after which the character rests; 0: never.
+    pub rest_ms: u32,
+    /// Cost per unit of segment energy while resting.
+    pub rest_cost: f32,
+    /// Cost per unit of segment energy at full voice level while speaking.
+    pub energy_cost: f32,
+}
+
+impl VoiceFollow {
+    /// Not following the voice: the paper's rule.
+    pub const NONE: Self = Self {
+        rest_ms: 0,
+        rest_cost: 0.0,
+        energy_cost: 0.0,
+    };
+}
+
+/// How fast a rest moves at most: this share of the library's median hand speed (a segment's
+/// energy `ln(REST_SPEED)` or less plays at its own pace while resting).
+pub const REST_SPEED: f32 = 0.2;
+
+/// The playback rate of a segment of energy `energy` while resting: its own pace if it is
+/// calm enough ([`REST_SPEED`]), else slower in proportion, down to the player's
+/// [`MIN_RATE`](crate::player::MIN_RATE).
+pub fn rest_rate(energy: f32) -> f32 {
+    let r = REST_SPEED * libm::expf(-energy);
+    if r.is_finite() {
+        r.clamp(crate::player::MIN_RATE, 1.0)
+    } else {
+        1.0
+    }
+}
+
+/// The calmest segments, candidates at every exit point while resting.
+pub const REST_SET: usize = 6;
+
+/// Voice level (the step feature, 10 dB units) at which the energy weight is full.
+pub const VOICE_SPAN: f32 = 0.5;
+
+/// What just changed in the voice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VoiceChange {
+    /// The silence reached `rest_ms`: rest.
+    Rest,
+    /// The speech returned after a rest.
+    Speak,
+}
+
+/// The voice as the controller follows it: silence so far, the last syllable's level,
+/// whether resting. A few bytes; no allocation, no panics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Voice {
+    /// Pause steps since the last syllable or onset.
+    silent_steps: u32,
+    /// The last syllable's intensity relative to the running level (10 dB units).
+    level: f32,
+    resting: bool,
+    change: Option<VoiceChange>,
+}
+
+impl Voice {
+    /// Speaking at the running level, not resting.
+    pub const fn new() -> Self {
+        Self {
+            silent_steps: 0,
+            level: 0.0,
+            resting: false,
+            change: None,
+        }
+    }
+
+    /// A step: a pause step of `pause_ms` (silence goes on) or a syllable at `level`.
+    pub fn step(&mut self, f: &VoiceFollow, pause: bool, level: f32, pause_ms: u32) {
+        if !pause {
+            self.silent_steps = 0;
+            self.level = if level.is_finite() { level } else { 0.0 };
+            return;
+        }
+        self.silent_steps = self.silent_steps.saturating_add(1);
+        let rests = f.rest_ms > 0 && f.rest_cost > 0.0;
+        if rests && !self.resting && self.silent_steps.saturating_mul(pause_ms) >= f.rest_ms {
+            self.resting = true;
+            self.change = Some(VoiceChange::Rest);
+        }
+    }
+
+    /// A syllable onset: the silence ends; after a rest, the speech returns.
+    pub fn onset(&mut self) {
+        self.silent_steps = 0;
+        if self.resting {
+            self.resting = false;
+            self.level = VOICE_SPAN;
+            self.change = Some(VoiceChange::Speak);
+        }
+    }
+
+    /// Whether the character rests.
+    pub fn resting(&self) -> bool {
+        self.resting
+    }
+
+    /// What changed since the last call, once.
+    pub fn take_change(&mut self) -> Option<VoiceChange> {
+        self.change.take()
+    }
+
+    /// The energy weight `w` of a decision now (see the module docs).
+    pub fn weight(&self, f: &VoiceFollow) -> f32 {
+        if self.resting {
+            f.rest_cost
+        } else {
+            -f.energy_cost * (self.level / VOICE_SPAN).clamp(-1.0, 1.0)
+        }
+    }
+}
+
+impl Default for Voice {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The calmest segments of `t` (lowest energy, ties to the lower index), in order of energy:
+/// [`REST_SET`], or the calmer half of a smaller library (at least one), so a rest is never
+/// any segment at all.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RestSet {
+    segments: [u16; REST_SET],
+    len: usize,
+}
+
+impl RestSet {
+    /// No rest segments.
+    pub const EMPTY: Self = Self {
+        segments: [0; REST_SET],
+        len: 0,
+    };
+
+    /// The calmest segments of `t` (one pass per slot over the segments).
+    pub fn of<T: PolicyTables + ?Sized>(t: &T, segments: usize) -> Self {
+        let mut me = Self::EMPTY;
+        let n = segments.min(u16::MAX as usize + 1);
+        let want = REST_SET.min((n / 2).max(1)).min(n);
+        while me.len < want {
+            let mut best: Option<(usize, f32)> = None;
+            for c in 0..n {
+                if me.contains(c) {
+                    continue;
+                }
+                let e = t.energy(c);
+                if best.is_none_or(|(_, b)| e < b) {
+                    best = Some((c, e));
+                }
+            }
+            let Some((c, _)) = best else { break };
+            me.segments[me.len] = c as u16;
+            me.len += 1;
+        }
+        me
+    }
+
+    /// The segments.
+    pub fn segments(&self) -> &[u16] {
+        &self.segments[..self.len]
+    }
+
+    /// Whether `c` is one of them.
+    pub fn contains(&self, c: usize) -> bool {
+        self.segments().iter().any(|&s| s as usize == c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const F: VoiceFollow = VoiceFollow {
+        rest_ms: 500,
+        rest_cost: 4.0,
+        energy_cost: 2.0,
+    };
+
+    #[test]
+    fn rest_begins_after_rest_ms_of_pause_steps_and_ends_at_an_onset() {
+        let mut v = Voice::new();
+        v.step(&F, false, 0.3, 250);
+        assert_eq!(v.weight(&F), -2.0 * 0.6);
+        v.step(&F, true, -6.0, 250);
+        assert!(!v.resting());
+        assert_eq!(v.take_change(), None);
+        v.step(&F, true, -6.0, 250);
+        assert!(v.resting());
+        assert_eq!(v.take_change(), Some(VoiceChange::Rest));
+        assert_eq!(v.take_change(), None);
+        assert_eq!(v.weight(&F), 4.0);
+        // More silence changes nothing.
+        v.step(&F, true, -6.0, 250);
+        assert_eq!(v.take_change(), None);
+        v.onset();
+        assert!(!v.resting());
+        assert_eq!(v.take_change(), Some(VoiceChange::Speak));
+        // The returning voice counts as full level until its first syllable is measured.
+        assert_eq!(v.weight(&F), -2.0);
+        v.step(&F, false, -0.25, 250);
+        assert_eq!(v.weight(&F), 1.0);
+    }
+
+    #[test]
+    fn a_syllable_between_pause_steps_restarts_the_count_and_none_never_rests() {
+        let mut v = Voice::new();
+        v.step(&F, true, -6.0, 250);
+        v.step(&F, false, 0.0, 250);
+        v.step(&F, true, -6.0, 250);
+        assert!(!v.resting());
+        let mut n = Voice::new();
+        for _ in 0..100 {
+            n.step(&VoiceFollow::NONE, true, -6.0, 250);
+        }
+        assert!(!n.resting());
+        assert_eq!(n.weight(&VoiceFollow::NONE), 0.0);
+        // An onset without a rest is no change.
+        n.onset();
+        assert_eq!(n.take_change(), None);
+    }
+
+    struct Energies(&'static [f32]);
+    impl PolicyTables for Energies {
+        fn states(&self) -> usize {
+            1
+        }
+        fn exit_count(&self) -> usize {
+            1
+        }
+        fn exit_segment(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_frame(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_is_end(&self, _: usize) -> bool {
+            true
+        }
+        fn first_exit(&self, _: usize) -> usize {
+            0
+        }
+        fn u(&self, _: usize, _: usize) -> f32 {
+            0.0
+        }
+        fn u_cont(&self, _: usize, _: usize) -> f32 {
+            0.0
+        }
+        fn successor_count(&self, _: usize) -> usize {
+            0
+        }
+        fn successor(&self, _: usize, _: usize) -> (usize, f32) {
+            (0, 0.0)
+        }
+        fn energy(&self, c: usize) -> f32 {
+            self.0[c]
+        }
+    }
+
+    #[test]
+    fn the_rest_rate_slows_what_is_faster_than_a_rest_down_to_half() {
+        assert_eq!(rest_rate(-3.0), 1.0);
+        assert_eq!(rest_rate(REST_SPEED.ln()), 1.0);
+        let r = rest_rate(REST_SPEED.ln() + 0.5);
+        assert!((r - (-0.5f32).exp()).abs() < 1e-6, "{r}");
+        assert_eq!(rest_rate(2.0), crate::player::MIN_RATE);
+        assert_eq!(rest_rate(f32::NAN), 1.0);
+    }
+
+    #[test]
+    fn the_rest_set_is_the_calmest_segments_in_order() {
+        let t = Energies(&[0.5, -1.0, 2.0, -2.0, -1.0, 0.0, 1.0, -0.5]);
+        let r = RestSet::of(&t, 8);
+        assert_eq!(r.segments(), &[3, 1, 4, 7]);
+        assert!(r.contains(7) && !r.contains(5));
+        let small = RestSet::of(&t, 2);
+        assert_eq!(small.segments(), &[1]);
+        assert_eq!(RestSet::of(&t, 1).segments(), &[0]);
+        let big = Energies(&[
+            0.5, -1.0, 2.0, -2.0, -1.0, 0.0, 1.0, -0.5, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0,
+        ]);
+        assert_eq!(RestSet::of(&big, 14).segments(), &[3, 1, 4, 7, 5, 0]);
+        assert_eq!(RestSet::of(&t, 0).segments(), &[] as &[u16]);
+    }
+}

@@ -1,0 +1,267 @@
+//! The body follows the voice (`gesture_runtime::follow`) through the whole controller: in a
+//! pause the character moves to the calmest segments even when no successor list holds one,
+//! holds the rest (played to and fro, never frozen) until the speech returns, and then cuts
+//! into a gesture at once; without it (`VoiceFollow::NONE`) the paper's rule keeps gesturing.
+
+use gesture_runtime::controller::{Controller, ControllerEvent};
+use gesture_runtime::follow::VoiceFollow;
+use gesture_runtime::inference::{CrfWeights, GmmComponent, I16Table};
+use gesture_runtime::player::LibraryFrames;
+use gesture_runtime::policy::{PolicyTables, Variety};
+use gesture_runtime::prosody::ProsodyConfig;
+
+/// Segments 0 and 1 gesture (energy +1, +0.5); 2 and 3 are calm (-2, -1.5) and listed as no
+/// exit's successor.
+const LENS: [usize; 4] = [45, 36, 30, 24];
+const ENERGY: [f32; 4] = [1.0, 0.5, -2.0, -1.5];
+
+struct Tables {
+    exits: Vec<(usize, usize, bool)>,
+}
+
+impl Tables {
+    fn new() -> Self {
+        let mut exits = Vec::new();
+        for (c, &len) in LENS.iter().enumerate() {
+            exits.push((c, len / 2, false));
+            exits.push((c, len - 1, true));
+        }
+        Self { exits }
+    }
+}
+
+impl PolicyTables for Tables {
+    fn states(&self) -> usize {
+        2
+    }
+    fn exit_count(&self) -> usize {
+        self.exits.len()
+    }
+    fn exit_segment(&self, e: usize) -> usize {
+        self.exits[e].0
+    }
+    fn exit_frame(&self, e: usize) -> usize {
+        self.exits[e].1
+    }
+    fn exit_is_end(&self, e: usize) -> bool {
+        self.exits[e].2
+    }
+    fn first_exit(&self, c: usize) -> usize {
+        2 * c
+    }
+    fn u(&self, c: usize, _s: usize) -> f32 {
+        [1.0, 1.2, 1.0, 1.0][c]
+    }
+    fn u_cont(&self, _e: usize, _s: usize) -> f32 {
+        1.1
+    }
+    fn successor_count(&self, _e: usize) -> usize {
+        2
+    }
+    fn successor(&self, _e: usize, k: usize) -> (usize, f32) {
+        [(0, 0.2), (1, 0.1)][k]
+    }
+    fn energy(&self, c: usize) -> f32 {
+        ENERGY[c]
+    }
+}
+
+struct Lib;
+
+impl LibraryFrames for Lib {
+    fn channels(&self) -> usize {
+        1
+    }
+    fn fps(&self) -> f32 {
+        30.0
+    }
+    fn segment_count(&self) -> usize {
+        4
+    }
+    fn segment_len(&self, c: usize) -> usize {
+        LENS[c]
+    }
+    fn value(&self, c: usize, f: usize, _ch: usize) -> f32 {
+        (c * 100 + f) as f32
+    }
+}
+
+/// Syllables at 3.5 Hz while `speaking(t)`, silence otherwise (16 kHz).
+fn audio(seconds: f32, speaking: impl Fn(f32) -> bool) -> Vec<i16> {
+    let n = (seconds * 16000.0) as usize;
+    let mut ph = 0.0f32;
+    (0..n)
+        .map(|i| {
+            let t = i as f32 / 16000.0;
+            ph += 2.0 * std::f32::consts::PI * 130.0 / 16000.0;
+            let env = if speaking(t) {
+                (2.0 * std::f32::consts::PI * 3.5 * t).sin().max(0.0)
+            } else {
+                0.0
+            };
+            (env * 9000.0 * (ph.sin() + 0.4 * (2.0 * ph).sin())) as i16
+        })
+        .collect()
+}
+
+/// Per tick: the segment and frame shown, whether a decision was made, whether an onset was
+/// heard before it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Tick {
+    segment: usize,
+    frame: usize,
+    pose: f32,
+    decided: bool,
+    onset: bool,
+}
+
+fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
+    let t = Tables::new();
+    let mut bytes = Vec::new();
+    for v in [0i16, 0, 0, 0] {
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    let crf = CrfWeights::new(
+        2,
+        2,
+        1,
+        I16Table::new(&bytes[..4], 1e-3, 2).unwrap(),
+        I16Table::new(&bytes, 1e-3, 4).unwrap(),
+        I16Table::new(&bytes, 1e-3, 4).unwrap(),
+    )
+    .unwrap();
+    let g = [GmmComponent::default(), GmmComponent::default()];
+    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &Lib).unwrap();
+    c.set_variety(Variety::NONE);
+    c.set_follow(follow);
+    let mut ticks: Vec<Tick> = Vec::new();
+    let mut heard = false;
+    let mut sink = |e: ControllerEvent<'_>| match e {
+        ControllerEvent::Pose {
+            segment,
+            frame,
+            pose,
+            ..
+        } => {
+            ticks.push(Tick {
+                segment,
+                frame,
+                pose: pose[0],
+                decided: false,
+                onset: heard,
+            });
+            heard = false;
+        }
+        ControllerEvent::Decision { .. } => {
+            if let Some(t) = ticks.last_mut() {
+                t.decided = true;
+            }
+        }
+        ControllerEvent::Onset(_) => heard = true,
+        _ => {}
+    };
+    for ch in samples.chunks(160) {
+        c.push(ch, &mut sink);
+    }
+    ticks
+}
+
+const FOLLOW: VoiceFollow = VoiceFollow {
+    rest_ms: 500,
+    rest_cost: 4.0,
+    energy_cost: 1.0,
+};
+
+fn rest(c: usize) -> bool {
+    ENERGY[c] < 0.0
+}
+
+#[test]
+fn a_pause_brings_the_calmest_segments_held_to_and_fro_until_the_speech_returns() {
+    // Speech 0-3 s, silence 3-7 s, speech 7-9 s.
+    let samples = audio(9.0, |t| !(3.0..7.0).contains(&t));
+    let ticks = run(&samples, FOLLOW);
+    let at = |s: f32| (s * 30.0) as usize;
+    // While speaking, gestures only.
+    assert!(ticks[..at(3.0)].iter().all(|t| !rest(t.segment)));
+    // Within 1.3 s of the silence (0.5 s to rest, at most 0.4 s for the hands to pause, the
+    // front-end's latency), a rest segment plays, though no successor list holds one.
+    let first_rest = ticks.iter().position(|t| rest(t.segment)).unwrap();
+    assert!(
+        (at(3.0)..=at(4.3)).contains(&first_rest),
+        "rest from tick {first_rest}"
+    );
+    // The speech returns: the first onset after the silence.
+    let back = (at(6.9)..ticks.len()).find(|&i| ticks[i].onset).unwrap();
+    assert!(back < at(7.3), "onset heard at tick {back}");
+    // The rest holds without a decision until then, the same segment throughout, its frames
+    // moving every tick or two (at the rest's pace) and turning back at its end.
+    let held = &ticks[first_rest + 1..back];
+    assert!(held.iter().all(|t| t.segment == ticks[first_rest].segment));
+    assert!(held.iter().all(|t| !t.decided));
+    for w in held.windows(3) {
+        assert!(
+            w[0].pose != w[1].pose || w[1].pose != w[2].pose,
+            "frozen at {:?}",
+            w
+        );
+    }
+    assert!(held.windows(2).any(|w| w[1].frame < w[0].frame));
+    assert!(held.windows(2).any(|w| w[1].frame > w[0].frame));
+    // The speech brings a gesture at once: a decision on the onset's tick, the cut not put
+    // off (its first frames show on the next tick).
+    assert!(ticks[back].decided || ticks[back + 1].decided);
+    assert!(
+        !rest(ticks[back + 2].segment),
+        "{:?}",
+        &ticks[back..back + 3]
+    );
+}
+
+#[test]
+fn without_following_the_voice_a_pause_plays_gestures() {
+    let samples = audio(9.0, |t| !(3.0..7.0).contains(&t));
+    let ticks = run(&samples, VoiceFollow::NONE);
+    assert!(ticks.iter().all(|t| !rest(t.segment)));
+    // Resting needs both a time and a cost.
+    let no_cost = VoiceFollow {
+        rest_cost: 0.0,
+        ..FOLLOW
+    };
+    assert!(run(&samples, no_cost).iter().all(|t| !rest(t.segment)));
+}
+
+#[test]
+fn louder_syllables_choose_more_energetic_segments() {
+    // Entering 0 (energy 1) costs 1.2, entering 1 (energy 0.5) 1.3: without a voice term 0
+    // wins every time; the term adds `-energy_cost * level / VOICE_SPAN` per unit of energy
+    // (saturating), so a voice well below its running level brings 1, above it 0.
+    let strong = VoiceFollow {
+        energy_cost: 4.0,
+        rest_ms: 0,
+        ..FOLLOW
+    };
+    let share_of_1 = |scale: f32| {
+        let samples: Vec<i16> = audio(8.0, |_| true)
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                if i > 3 * 16000 {
+                    (v as f32 * scale) as i16
+                } else {
+                    v
+                }
+            })
+            .collect();
+        let ticks = run(&samples, strong);
+        let later = &ticks[(3.5 * 30.0) as usize..];
+        later.iter().filter(|t| t.segment == 1).count() as f64 / later.len() as f64
+    };
+    assert!(run(&audio(8.0, |_| true), VoiceFollow::NONE)
+        .iter()
+        .all(|t| t.segment == 0));
+    let (steady, quiet, loud) = (share_of_1(1.0), share_of_1(0.25), share_of_1(2.0));
+    // 12 dB quieter: mostly the calmer gesture; 6 dB louder: no more of it than steady.
+    assert!(quiet > 0.6 && quiet > steady + 0.3, "{quiet} vs {steady}");
+    assert!(loud <= steady, "{loud} vs {steady}");
+}
