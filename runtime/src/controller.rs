@@ -924,24 +924,22 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             None => (self.exit, false),
         };
         self.waited = 0;
-        self.decide_with(e, tick, reached, change == VoiceChange::Rest, sink);
+        self.decide_with(e, tick, reached, sink);
         true
     }
 
-    /// Decides at exit `e` (reached) and acts on it, a mid-segment cut waiting for the hands.
+    /// Decides at exit `e` (reached) and acts on it.
     fn decide(&mut self, e: usize, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
-        self.decide_with(e, tick, true, true, sink);
+        self.decide_with(e, tick, true, sink);
     }
 
-    /// Decides at exit `e` and acts on it: `reached` whether the playback has come to `e`
-    /// (choosing to continue at one not yet reached leaves it the next exit point), `defer`
-    /// whether a mid-segment cut waits for the hands to pause.
+    /// Decides at exit `e` and acts on it; `reached` whether the playback has come to `e`
+    /// (choosing to continue at one not yet reached leaves it the next exit point).
     fn decide_with(
         &mut self,
         e: usize,
         tick: u64,
         reached: bool,
-        defer: bool,
         sink: &mut impl FnMut(ControllerEvent<'_>),
     ) {
         let now = tick.min(u32::MAX as u64) as u32;
@@ -954,11 +952,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         )
         .with_voice(
             self.voice.weight(&self.follow),
-            if self.voice.resting() {
-                self.rest.segments()
-            } else {
-                &[]
-            },
+            self.rest.segments(),
+            self.voice.resting(),
+            self.follow.rest_cost,
         );
         let s = self.tables.states();
         let b = match &self.held_belief {
@@ -1004,8 +1000,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                 } else {
                     self.player.frame().saturating_sub(1)
                 };
-                let defer = defer
-                    && !seamless
+                let defer = !seamless
                     && waiting.is_none()
                     && self.timing.defer_cut_ms > 0
                     && !self.hands_pause(self.player.segment(), shown);

@@ -26,12 +26,17 @@
 //!   library's own: its calmest segments, breathing and drifting as the capture did.
 //! - **speaking**: `w = -energy_cost * clamp(level / VOICE_SPAN, -1, 1)`, `level` the last
 //!   syllable's intensity relative to the speaker's running level (the CRF's own step feature,
-//!   in 10 dB units): louder than usual favours energetic segments, quieter calm ones.
+//!   in 10 dB units): louder than usual favours energetic segments, quieter calm ones. And the
+//!   rest segments cost `rest_cost` more (entering or continuing one): they are the capture's
+//!   rests, which a speaker does not show while talking (on the 9-joint ZeroEGGS library the
+//!   variety costs otherwise brought its nine-second rests into the middle of sentences).
 //! - **the speech returns** (the first onset after resting): the controller decides at once,
-//!   at the playing segment's next exit point, and cuts without waiting (the hands are at
-//!   rest, so there is no stroke to spare); the voice level counts as `+VOICE_SPAN` until the
-//!   first syllable is measured (speech out of silence is as loud as it gets relative to it).
-//!   The chosen segment is entered at its first frame: a preparation, not a stroke.
+//!   at the playing segment's next exit point; the cut waits for a pause of the hands like
+//!   any mid-segment cut, which a rest's calm frames give at once (after a short silence the
+//!   playing gesture may still be finishing its stroke: cutting it there would jump); the
+//!   voice level counts as `+VOICE_SPAN` until the first syllable is measured (speech out of
+//!   silence is as loud as it gets relative to it). The chosen segment is entered at its
+//!   first frame: a preparation, not a stroke.
 //!
 //! - **the rest's pace**: a library with no true rest (a monologue's capture: the calmest
 //!   segments of the shared 067 take move at 0.4 of its median hand speed) would still gesture

@@ -34,6 +34,11 @@
 //! the neutral weight, computed per candidate as `d_0 (b . U) + sum_m d_m (b . U^m)` from the
 //! stored tables, so no mixed copy is kept in RAM. The neutral style reads the neutral tables alone, exactly as a blob without tones.
 //!
+//! **The voice** ([`crate::follow`]). [`Penalties::with_voice`] adds an energy weight per
+//! decision (`w * energy(c)` for every candidate, continuing included) and the rest segments:
+//! while resting they are candidates at every exit point beside its successors (at the
+//! exit's largest successor cost), while speaking each costs a flat penalty more.
+//!
 //! The tables come from a validated blob through [`PolicyTables`]; every index the selector
 //! uses was range-checked at load, so nothing here can panic.
 
@@ -380,9 +385,13 @@ pub struct Penalties {
     len: usize,
     /// Cost per unit of a candidate's energy ([`crate::follow`]).
     energy_weight: f32,
-    /// Candidates beside the exit's successors (the rest segments while resting).
-    extra: [u16; REST_SET],
-    extra_len: usize,
+    /// The rest segments ([`crate::follow::RestSet`]).
+    rest: [u16; REST_SET],
+    rest_len: usize,
+    /// Whether the rest segments are candidates beside the exit's successors (resting).
+    rest_extra: bool,
+    /// Cost added to a rest segment as a candidate (speaking).
+    rest_penalty: f32,
 }
 
 impl Penalties {
@@ -393,19 +402,45 @@ impl Penalties {
         usage: [0.0; HISTORY],
         len: 0,
         energy_weight: 0.0,
-        extra: [0; REST_SET],
-        extra_len: 0,
+        rest: [0; REST_SET],
+        rest_len: 0,
+        rest_extra: false,
+        rest_penalty: 0.0,
     };
 
     /// The same penalties with every candidate charged `weight` times its energy (continuing
-    /// too), and the segments `extra` (at most [`REST_SET`]) candidates at every exit point
-    /// beside its successors, at the largest successor cost of that exit.
-    pub fn with_voice(mut self, weight: f32, extra: &[u16]) -> Self {
+    /// too) and the rest segments `rest` (at most [`REST_SET`]) treated as the voice asks
+    /// ([`crate::follow`]): `resting`, they are candidates at every exit point beside its
+    /// successors, at the largest successor cost of that exit; speaking, each costs
+    /// `rest_penalty` more wherever it is a candidate (continuing included).
+    pub fn with_voice(
+        mut self,
+        weight: f32,
+        rest: &[u16],
+        resting: bool,
+        rest_penalty: f32,
+    ) -> Self {
         self.energy_weight = if weight.is_finite() { weight } else { 0.0 };
-        let n = extra.len().min(REST_SET);
-        self.extra[..n].copy_from_slice(&extra[..n]);
-        self.extra_len = n;
+        let n = rest.len().min(REST_SET);
+        self.rest[..n].copy_from_slice(&rest[..n]);
+        self.rest_len = n;
+        self.rest_extra = resting;
+        self.rest_penalty = if !resting && rest_penalty.is_finite() {
+            rest_penalty
+        } else {
+            0.0
+        };
         self
+    }
+
+    /// The voice's cost of segment `c`: its energy term, and the rest penalty if it is a rest
+    /// segment.
+    fn voice<T: PolicyTables + ?Sized>(&self, t: &T, c: usize) -> f32 {
+        let mut v = self.energy(t, c);
+        if self.rest_penalty != 0.0 && self.rest[..self.rest_len].iter().any(|&r| r as usize == c) {
+            v += self.rest_penalty;
+        }
+        v
     }
 
     /// The energy term of segment `c`.
@@ -519,21 +554,26 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
     };
     if !t.exit_is_end(e) {
         let a = t.exit_segment(e);
-        best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(a) + penalty.energy(t, a);
+        best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(a) + penalty.voice(t, a);
         best.candidates = 1;
     }
     let mut worst_junction = 0.0f32;
     for k in 0..t.successor_count(e) {
         let (c, sc) = t.successor(e, k);
         worst_junction = worst_junction.max(sc);
-        let v = sc + style.u_dot(t, c, b) + penalty.of(c) + penalty.energy(t, c);
+        let v = sc + style.u_dot(t, c, b) + penalty.of(c) + penalty.voice(t, c);
         best.candidates += 1;
         if v < best.cost {
             best.cost = v;
             best.choice = Choice::Enter(c);
         }
     }
-    for &c in &penalty.extra[..penalty.extra_len] {
+    let extra = if penalty.rest_extra {
+        &penalty.rest[..penalty.rest_len]
+    } else {
+        &[]
+    };
+    for &c in extra {
         let c = c as usize;
         let v = worst_junction + style.u_dot(t, c, b) + penalty.of(c) + penalty.energy(t, c);
         best.candidates += 1;

@@ -84,6 +84,10 @@ impl LibraryFrames for Lib {
     fn value(&self, c: usize, f: usize, _ch: usize) -> f32 {
         (c * 100 + f) as f32
     }
+    /// The calm segments' frames are calm (as `pack` marks the slowest frames).
+    fn is_calm(&self, c: usize, _f: usize) -> bool {
+        ENERGY[c] < 0.0
+    }
 }
 
 /// Syllables at 3.5 Hz while `speaking(t)`, silence otherwise (16 kHz).
@@ -209,7 +213,7 @@ fn a_pause_brings_the_calmest_segments_held_to_and_fro_until_the_speech_returns(
     assert!(held.windows(2).any(|w| w[1].frame < w[0].frame));
     assert!(held.windows(2).any(|w| w[1].frame > w[0].frame));
     // The speech brings a gesture at once: a decision on the onset's tick, the cut not put
-    // off (its first frames show on the next tick).
+    // off (the rest's frames are calm; its first frames show on the next tick).
     assert!(ticks[back].decided || ticks[back + 1].decided);
     assert!(
         !rest(ticks[back + 2].segment),

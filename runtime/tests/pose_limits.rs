@@ -43,7 +43,12 @@ fn enormous_frames_and_blends_give_finite_poses_within_the_limits() {
         continues: false,
     };
     p.library = OwnedLibrary::new(30.0, 1, &frames, &[seg(0), seg(3)], &[], &[]).unwrap();
-    p.control = ControlSection::new(&DecisionTiming::DEFAULT, &Variety::NONE, 400);
+    p.control = ControlSection::new(
+        &DecisionTiming::DEFAULT,
+        &Variety::NONE,
+        &gesture_runtime::follow::VoiceFollow::NONE,
+        400,
+    );
     let out = poses(&p.encode().unwrap());
     assert!(out.len() > 50, "{} poses", out.len());
     let cal = ChannelCal::HOBBY;

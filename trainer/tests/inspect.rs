@@ -45,7 +45,7 @@ fn summarizes_a_valid_blob() {
     let text = String::from_utf8(out.stdout).unwrap();
     for want in [
         format!(
-            "blob: {n} bytes, format version 6, flags 0x0000, payload {} bytes",
+            "blob: {n} bytes, format version 7, flags 0x0000, payload {} bytes",
             n - 16
         ),
         "sections (bytes): front_end ".to_string(),
@@ -55,6 +55,10 @@ fn summarizes_a_valid_blob() {
             .to_string(),
         "variety: recency cost 0 over 0 ms, usage cost 0 over 0 ms; cuts blended over 0 ms; \
          beat hold 0 ms"
+            .to_string(),
+        "voice: never rests; energy cost 0 at full voice level".to_string(),
+        "segment energy (ln of mean hand speed over the median): 0.00 to 0.00; calmest: 0 \
+         (0.00, 3 frames)"
             .to_string(),
         "inference: 2 states, 1 clusters, window 1".to_string(),
         "policy: 2 segments, 3 exit points (2 end, 1 interruption), 4 successor entries \

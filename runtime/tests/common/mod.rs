@@ -392,11 +392,11 @@ pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-/// The tiny blob's bytes (format version 6: `styles` and `labels` absent, the final `00 00`;
+/// The tiny blob's bytes (format version 7: `styles` and `labels` absent, the final `00 00`;
 /// the `control` section after `policy.succ_cost_scale` is
-/// `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601 c801`; the
+/// `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601 c801 ee05 00002040 0000c03f`; the
 /// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4), `calm` `01 21`
-/// (frames 0 and 5) and no `groups`,
+/// (frames 0 and 5), `energy` `02 f0 18` (-1 and 1.5 in sixteenths) and no `groups`,
 /// `00`). Changing the format changes
 /// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(

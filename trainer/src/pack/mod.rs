@@ -66,11 +66,17 @@ pub const DEFAULT_VARIETY: Variety = Variety {
     usage_ms: 45000,
 };
 
-/// How a blob follows the voice by default (see `gesture_runtime::follow`).
+/// How a blob follows the voice by default (see `gesture_runtime::follow`): chosen with
+/// `gesture-train eval-motion` on tuning speech (the 9-joint ZeroEGGS model and library on
+/// its held-out 90-121 s, the 067 model and library on the first 60 s of the 9-joint take's
+/// speech; 10 device runs each), never on the speech the README reports. The energy cost
+/// brought the pause/speech hand-speed ratio from 0.17-0.28 (at 1) to 0.05-0.10 and the
+/// speech coupling from 0.30/0.58 to 0.52/0.65 (the captures: 0.55/0.62); 3 and 4 gave no
+/// more. Resting after two pause steps (500 ms) leaves the short breaths of a sentence alone.
 pub const DEFAULT_FOLLOW: VoiceFollow = VoiceFollow {
     rest_ms: 500,
     rest_cost: 4.0,
-    energy_cost: 1.0,
+    energy_cost: 2.0,
 };
 
 /// Inertialization time at cuts a blob gets by default (ms).
