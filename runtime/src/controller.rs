@@ -943,16 +943,17 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         sink: &mut impl FnMut(ControllerEvent<'_>),
     ) {
         let now = tick.min(u32::MAX as u64) as u32;
-        let penalties = Penalties::new(
+        let mut penalties = Penalties::new(
             &self.variety,
             &self.history,
             now,
             self.ms_ticks(self.variety.recency_ms),
             self.ms_ticks(self.variety.usage_ms),
-        )
-        .with_voice(
+        );
+        penalties.set_voice(
             self.voice.weight(&self.follow),
             self.rest.segments(),
+            self.rest.energy(),
             self.voice.resting(),
             self.follow.rest_cost,
         );

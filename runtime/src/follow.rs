@@ -88,7 +88,7 @@ pub fn rest_rate(energy: f32) -> f32 {
 }
 
 /// The calmest segments, candidates at every exit point while resting.
-pub const REST_SET: usize = 6;
+pub const REST_SET: usize = 4;
 
 /// Voice level (the step feature, 10 dB units) at which the energy weight is full.
 pub const VOICE_SPAN: f32 = 0.5;
@@ -179,10 +179,12 @@ impl Default for Voice {
 /// The calmest segments of `t` (lowest energy, ties to the lower index), in order of energy:
 /// [`REST_SET`], or the calmer half of a smaller library (at least one), so a rest is never
 /// any segment at all.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestSet {
     segments: [u16; REST_SET],
     len: usize,
+    /// The highest energy among them (-inf when there are none).
+    energy: f32,
 }
 
 impl RestSet {
@@ -190,6 +192,7 @@ impl RestSet {
     pub const EMPTY: Self = Self {
         segments: [0; REST_SET],
         len: 0,
+        energy: f32::NEG_INFINITY,
     };
 
     /// The calmest segments of `t` (one pass per slot over the segments).
@@ -208,9 +211,10 @@ impl RestSet {
                     best = Some((c, e));
                 }
             }
-            let Some((c, _)) = best else { break };
+            let Some((c, e)) = best else { break };
             me.segments[me.len] = c as u16;
             me.len += 1;
+            me.energy = e;
         }
         me
     }
@@ -218,6 +222,12 @@ impl RestSet {
     /// The segments.
     pub fn segments(&self) -> &[u16] {
         &self.segments[..self.len]
+    }
+
+    /// The highest energy among them: while speaking, any segment this calm costs as a rest
+    /// (-inf when there are none).
+    pub fn energy(&self) -> f32 {
+        self.energy
     }
 
     /// Whether `c` is one of them.
@@ -331,6 +341,8 @@ mod tests {
         let t = Energies(&[0.5, -1.0, 2.0, -2.0, -1.0, 0.0, 1.0, -0.5]);
         let r = RestSet::of(&t, 8);
         assert_eq!(r.segments(), &[3, 1, 4, 7]);
+        assert_eq!(r.energy(), -0.5);
+        assert_eq!(RestSet::EMPTY.energy(), f32::NEG_INFINITY);
         assert!(r.contains(7) && !r.contains(5));
         let small = RestSet::of(&t, 2);
         assert_eq!(small.segments(), &[1]);
@@ -338,7 +350,7 @@ mod tests {
         let big = Energies(&[
             0.5, -1.0, 2.0, -2.0, -1.0, 0.0, 1.0, -0.5, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0,
         ]);
-        assert_eq!(RestSet::of(&big, 14).segments(), &[3, 1, 4, 7, 5, 0]);
+        assert_eq!(RestSet::of(&big, 14).segments(), &[3, 1, 4, 7]);
         assert_eq!(RestSet::of(&t, 0).segments(), &[] as &[u16]);
     }
 }

@@ -34,7 +34,7 @@
 //! the neutral weight, computed per candidate as `d_0 (b . U) + sum_m d_m (b . U^m)` from the
 //! stored tables, so no mixed copy is kept in RAM. The neutral style reads the neutral tables alone, exactly as a blob without tones.
 //!
-//! **The voice** ([`crate::follow`]). [`Penalties::with_voice`] adds an energy weight per
+//! **The voice** ([`crate::follow`]). [`Penalties::set_voice`] adds an energy weight per
 //! decision (`w * energy(c)` for every candidate, continuing included) and the rest segments:
 //! while resting they are candidates at every exit point beside its successors (at the
 //! exit's largest successor cost), while speaking each costs a flat penalty more.
@@ -392,6 +392,8 @@ pub struct Penalties {
     rest_extra: bool,
     /// Cost added to a rest segment as a candidate (speaking).
     rest_penalty: f32,
+    /// The rest set's highest energy: a candidate this calm is a rest (speaking).
+    rest_energy: f32,
 }
 
 impl Penalties {
@@ -406,50 +408,51 @@ impl Penalties {
         rest_len: 0,
         rest_extra: false,
         rest_penalty: 0.0,
+        rest_energy: f32::NEG_INFINITY,
     };
 
-    /// The same penalties with every candidate charged `weight` times its energy (continuing
+    /// Charges every candidate `weight` times its energy (continuing
     /// too) and the rest segments `rest` (at most [`REST_SET`]) treated as the voice asks
     /// ([`crate::follow`]): `resting`, they are candidates at every exit point beside its
-    /// successors, at the largest successor cost of that exit; speaking, each costs
-    /// `rest_penalty` more wherever it is a candidate (continuing included).
-    pub fn with_voice(
-        mut self,
+    /// successors, at the largest successor cost of that exit; speaking, every candidate as
+    /// calm as the calmest of them (energy at most `rest_energy`) costs `rest_penalty` more
+    /// (continuing included).
+    pub fn set_voice(
+        &mut self,
         weight: f32,
         rest: &[u16],
+        rest_energy: f32,
         resting: bool,
         rest_penalty: f32,
-    ) -> Self {
+    ) {
         self.energy_weight = if weight.is_finite() { weight } else { 0.0 };
         let n = rest.len().min(REST_SET);
         self.rest[..n].copy_from_slice(&rest[..n]);
         self.rest_len = n;
         self.rest_extra = resting;
-        self.rest_penalty = if !resting && rest_penalty.is_finite() {
-            rest_penalty
+        let speaking = !resting && rest_penalty.is_finite() && rest_penalty != 0.0;
+        self.rest_penalty = if speaking { rest_penalty } else { 0.0 };
+        self.rest_energy = if speaking && !rest_energy.is_nan() {
+            rest_energy
+        } else {
+            f32::NEG_INFINITY
+        };
+    }
+
+    /// The voice's cost of segment `c`: its energy term, and the rest penalty if it is as calm
+    /// as a rest (one read of its energy).
+    #[inline]
+    fn voice<T: PolicyTables + ?Sized>(&self, t: &T, c: usize) -> f32 {
+        if self.energy_weight == 0.0 && self.rest_penalty == 0.0 {
+            return 0.0;
+        }
+        let e = t.energy(c);
+        let rest = if e <= self.rest_energy {
+            self.rest_penalty
         } else {
             0.0
         };
-        self
-    }
-
-    /// The voice's cost of segment `c`: its energy term, and the rest penalty if it is a rest
-    /// segment.
-    fn voice<T: PolicyTables + ?Sized>(&self, t: &T, c: usize) -> f32 {
-        let mut v = self.energy(t, c);
-        if self.rest_penalty != 0.0 && self.rest[..self.rest_len].iter().any(|&r| r as usize == c) {
-            v += self.rest_penalty;
-        }
-        v
-    }
-
-    /// The energy term of segment `c`.
-    fn energy<T: PolicyTables + ?Sized>(&self, t: &T, c: usize) -> f32 {
-        if self.energy_weight == 0.0 {
-            0.0
-        } else {
-            self.energy_weight * t.energy(c)
-        }
+        self.energy_weight * e + rest
     }
 
     /// The penalties at tick `now` given `history` and the windows in ticks (`recency_ticks`,
@@ -560,7 +563,9 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
     let mut worst_junction = 0.0f32;
     for k in 0..t.successor_count(e) {
         let (c, sc) = t.successor(e, k);
-        worst_junction = worst_junction.max(sc);
+        if penalty.rest_extra {
+            worst_junction = worst_junction.max(sc);
+        }
         let v = sc + style.u_dot(t, c, b) + penalty.of(c) + penalty.voice(t, c);
         best.candidates += 1;
         if v < best.cost {
@@ -575,7 +580,7 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
     };
     for &c in extra {
         let c = c as usize;
-        let v = worst_junction + style.u_dot(t, c, b) + penalty.of(c) + penalty.energy(t, c);
+        let v = worst_junction + style.u_dot(t, c, b) + penalty.of(c) + penalty.voice(t, c);
         best.candidates += 1;
         if v < best.cost {
             best.cost = v;

@@ -472,7 +472,7 @@ impl<'a> Blob<'a> {
             .library
             .energy
             .get(s)
-            .map_or(0.0, |&q| q as i8 as f32 / super::ENERGY_SCALE)
+            .map_or(0.0, |&q| q as i8 as f32 * (1.0 / super::ENERGY_SCALE))
     }
 
     /// Rotation groups (records of `library.groups`).

@@ -172,7 +172,9 @@ pub fn entries_from_frames(
             });
             continue;
         };
-        if seg != ps || (frame < pf && frame == 0) {
+        // A segment entered again shows its first frame after a later one; one frame back to
+        // the first is a rest played to and fro (`Player::turn`), not an entry.
+        if seg != ps || (frame == 0 && pf >= 2) {
             let on = seg == ps + 1 && continues(ps) && pf + 1 >= len(ps) && frame == 0;
             out.push(Entry {
                 frame: t,
@@ -960,7 +962,9 @@ mod tests {
 
     #[test]
     fn entries_come_from_segment_changes_and_restarts() {
-        // Segment 0 (3 frames) runs on into its successor 1; 1 is cut into 5; 5 restarts.
+        // Segment 0 (3 frames) runs on into its successor 1; 1 is cut into 5; 5 restarts from
+        // its last frame, then plays back to its first and turns (a rest played to and fro:
+        // no entry).
         let shown = [
             (0, 0),
             (0, 1),
@@ -968,6 +972,11 @@ mod tests {
             (1, 0),
             (1, 1),
             (5, 0),
+            (5, 1),
+            (5, 2),
+            (5, 0),
+            (5, 1),
+            (5, 2),
             (5, 1),
             (5, 0),
             (5, 1),
@@ -977,7 +986,7 @@ mod tests {
             e.iter().map(|e| (e.frame, e.segment, e.cut)).collect();
         assert_eq!(
             got,
-            [(0, 0, false), (3, 1, false), (5, 5, true), (7, 5, true)]
+            [(0, 0, false), (3, 1, false), (5, 5, true), (8, 5, true)]
         );
         // Entering the successor from the middle of a segment is a cut.
         let shown = [(0, 0), (1, 0)];
