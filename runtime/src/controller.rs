@@ -952,7 +952,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         );
         penalties.set_voice(
             self.voice.weight(&self.follow),
-            self.rest.segments(),
+            self.rest.extras(),
             self.rest.energy(),
             self.voice.resting(),
             self.follow.rest_cost,

@@ -15,7 +15,7 @@
 //! median frame speed, computed by `pack`: `library.energy`) and `w` comes from the voice:
 //!
 //! - **resting** (the speech has been silent for `rest_ms`, counted in the front-end's pause
-//!   steps): `w = rest_cost`, so the calmest segments cost least. The `REST_SET` calmest
+//!   steps): `w = rest_cost`, so the calmest segments cost least. The `REST_EXTRAS` calmest
 //!   segments of the library are candidates at every exit point while resting (the pruned
 //!   successor lists need not hold one), at the largest successor cost of that exit (an entry
 //!   no better than the worst listed junction; the player's blend makes every cut seamless).
@@ -88,7 +88,12 @@ pub fn rest_rate(energy: f32) -> f32 {
 }
 
 /// The calmest segments, candidates at every exit point while resting.
-pub const REST_SET: usize = 4;
+pub const REST_SET: usize = 6;
+
+/// The calmest of those, candidates at every exit point while resting (each candidate costs a
+/// dot product per value table mixed: six under a three-tone style took the worst decision
+/// past 50 k instructions on a Cortex-M4F).
+pub const REST_EXTRAS: usize = 4;
 
 /// Voice level (the step feature, 10 dB units) at which the energy weight is full.
 pub const VOICE_SPAN: f32 = 0.5;
@@ -224,6 +229,11 @@ impl RestSet {
         &self.segments[..self.len]
     }
 
+    /// The calmest [`REST_EXTRAS`] of them: candidates at every exit point while resting.
+    pub fn extras(&self) -> &[u16] {
+        &self.segments[..self.len.min(REST_EXTRAS)]
+    }
+
     /// The highest energy among them: while speaking, any segment this calm costs as a rest
     /// (-inf when there are none).
     pub fn energy(&self) -> f32 {
@@ -350,7 +360,9 @@ mod tests {
         let big = Energies(&[
             0.5, -1.0, 2.0, -2.0, -1.0, 0.0, 1.0, -0.5, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0,
         ]);
-        assert_eq!(RestSet::of(&big, 14).segments(), &[3, 1, 4, 7]);
+        let r = RestSet::of(&big, 14);
+        assert_eq!(r.segments(), &[3, 1, 4, 7, 5, 0]);
+        assert_eq!((r.extras(), r.energy()), (&[3u16, 1, 4, 7][..], 0.5));
         assert_eq!(RestSet::of(&t, 0).segments(), &[] as &[u16]);
     }
 }

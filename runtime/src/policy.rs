@@ -44,7 +44,7 @@
 
 use heapless::HistoryBuffer;
 
-use crate::follow::REST_SET;
+use crate::follow::REST_EXTRAS;
 
 /// The policy tables as the selector needs them. Implementations must only be built from
 /// validated data: every method is called with indices in range.
@@ -386,7 +386,7 @@ pub struct Penalties {
     /// Cost per unit of a candidate's energy ([`crate::follow`]).
     energy_weight: f32,
     /// The rest segments ([`crate::follow::RestSet`]).
-    rest: [u16; REST_SET],
+    rest: [u16; REST_EXTRAS],
     rest_len: usize,
     /// Whether the rest segments are candidates beside the exit's successors (resting).
     rest_extra: bool,
@@ -404,7 +404,7 @@ impl Penalties {
         usage: [0.0; HISTORY],
         len: 0,
         energy_weight: 0.0,
-        rest: [0; REST_SET],
+        rest: [0; REST_EXTRAS],
         rest_len: 0,
         rest_extra: false,
         rest_penalty: 0.0,
@@ -412,7 +412,7 @@ impl Penalties {
     };
 
     /// Charges every candidate `weight` times its energy (continuing
-    /// too) and the rest segments `rest` (at most [`REST_SET`]) treated as the voice asks
+    /// too) and the rest segments `rest` (at most [`REST_EXTRAS`]) treated as the voice asks
     /// ([`crate::follow`]): `resting`, they are candidates at every exit point beside its
     /// successors, at the largest successor cost of that exit; speaking, every candidate as
     /// calm as the calmest of them (energy at most `rest_energy`) costs `rest_penalty` more
@@ -426,7 +426,7 @@ impl Penalties {
         rest_penalty: f32,
     ) {
         self.energy_weight = if weight.is_finite() { weight } else { 0.0 };
-        let n = rest.len().min(REST_SET);
+        let n = rest.len().min(REST_EXTRAS);
         self.rest[..n].copy_from_slice(&rest[..n]);
         self.rest_len = n;
         self.rest_extra = resting;
