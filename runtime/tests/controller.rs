@@ -715,10 +715,11 @@ fn a_cut_decided_mid_segment_waits_for_the_hands_to_pause() {
     for &(e, t, cut) in &c {
         assert_eq!(cut, Some(t + 1), "exit {e} at tick {t}");
     }
-    // Deferred: the cut shows on the tick after the playing segment shows a beat, a calm
-    // frame or its last frame (at once if the decision's tick did), and at most 400 ms after
-    // the decision.
-    for (beat_every, calm) in [(5, false), (0, true), (0, false)] {
+    // Deferred: at once if the decision's tick showed a pause of the hands (a beat, a calm
+    // frame or the segment's last frame); else the cut shows on the tick after the playing
+    // segment reaches its first calm frame within 400 ms of frames, else its first beat
+    // there, else its last frame there, else the first pause that comes, however late.
+    for (beat_every, calm) in [(5, false), (0, true), (0, false), (5, true)] {
         let recs = run(beat_every, calm, DecisionTiming::DEFAULT);
         let sh = shown(&recs);
         let lib = Lib {
@@ -729,22 +730,31 @@ fn a_cut_decided_mid_segment_waits_for_the_hands_to_pause() {
         let (mut deferred, mut by_beat) = (0, 0);
         for (e, t, cut) in cuts(&recs) {
             let Some(cut) = cut else { continue };
-            let (seg, _) = sh[t as usize];
-            let pause = (t..=t + DEFER_TICKS).find(|&u| {
-                let f = sh[u as usize].1;
-                lib.is_beat(seg, f) || lib.is_calm(seg, f) || f + 1 == lib.lens[seg]
-            });
-            let want = pause.map_or(t + 1 + DEFER_TICKS, |u| u + 1);
+            let (seg, f0) = sh[t as usize];
+            let last = lib.lens[seg] - 1;
+            let pause = |f: usize| lib.is_beat(seg, f) || lib.is_calm(seg, f) || f == last;
+            let window = f0 + 1..=(f0 + DEFER_TICKS as usize).min(last);
+            let target = if pause(f0) {
+                f0
+            } else {
+                window
+                    .clone()
+                    .find(|&f| lib.is_calm(seg, f))
+                    .or_else(|| window.clone().find(|&f| lib.is_beat(seg, f)))
+                    .or_else(|| window.clone().find(|&f| f == last))
+                    .unwrap_or_else(|| (f0 + 1..=last).find(|&f| pause(f)).unwrap_or(last))
+            };
+            let u = (t..sh.len() as u64)
+                .find(|&u| sh[u as usize] == (seg, target))
+                .unwrap();
             assert_eq!(
-                cut, want,
+                cut,
+                u + 1,
                 "beats every {beat_every}, calm {calm}: exit {e} at tick {t}"
             );
             if cut > t + 1 {
                 deferred += 1;
-                by_beat += pause.is_some_and(|u| {
-                    let f = sh[u as usize].1;
-                    lib.is_beat(seg, f) || lib.is_calm(seg, f)
-                }) as usize;
+                by_beat += (lib.is_beat(seg, target) || lib.is_calm(seg, target)) as usize;
             }
         }
         assert!(deferred > 0, "beats every {beat_every}: no cut deferred");

@@ -51,7 +51,7 @@ fn summarizes_a_valid_blob() {
         "sections (bytes): front_end ".to_string(),
         "front_end: 16000 Hz, pitch 75-600 Hz".to_string(),
         "control: decisions on syllable onsets (within 50 ms; a segment end waits up to 300 ms); \
-         a cut decided mid-segment waits up to 400 ms for the hands to pause"
+         a cut decided mid-segment waits for the hands' calmest pause within 400 ms"
             .to_string(),
         "variety: recency cost 0 over 0 ms, usage cost 0 over 0 ms; cuts blended over 0 ms; \
          beat hold 0 ms"

@@ -284,7 +284,8 @@ pub struct ControlSection {
     pub blend_ms: u16,
     /// Longest hold at a motion beat waiting for a syllable onset (ms; 0: no holds).
     pub beat_hold_ms: u16,
-    /// Longest delay of a cut decided mid-segment until the hands pause (ms; 0: cut at once).
+    /// How far ahead (ms) a cut decided mid-segment looks for the hands' calmest next pause
+    /// (0: cut at once).
     pub defer_cut_ms: u16,
     /// Silence (ms) after which the character rests ([`VoiceFollow::rest_ms`](crate::follow::VoiceFollow::rest_ms); 0: never).
     pub rest_ms: u16,

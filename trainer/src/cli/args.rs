@@ -220,9 +220,10 @@ pub struct DeviceArgs {
     /// holds).
     #[arg(long, default_value_t = DecisionTiming::DEFAULT.beat_hold_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_BEAT_HOLD_MS as i64))]
     pub beat_hold_ms: u32,
-    /// Longest delay of a cut decided in the middle of a segment until the playing
-    /// segment's hands pause (a motion beat, a calm frame or its last frame), so the cut falls
-    /// between strokes (ms; 0: cut at once).
+    /// A cut decided in the middle of a segment waits for the playing segment's hands to
+    /// pause: its first calm frame within this many ms, else its first motion beat there, else
+    /// its last frame there, else the first of these that comes, so the cut falls between
+    /// strokes (ms; 0: cut at once).
     #[arg(long, default_value_t = DecisionTiming::DEFAULT.defer_cut_ms, value_parser = clap::value_parser!(u32).range(0..=gesture_runtime::blob::MAX_DEFER_CUT_MS as i64))]
     pub defer_cut_ms: u32,
     /// Cost of entering a segment entered just now, falling to 0 over --recency-ms (0: no

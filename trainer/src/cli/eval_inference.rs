@@ -2,9 +2,19 @@
 //! the online beliefs of the CRF, Brand's remapped HMM and the state prior on `--test` for each
 //! window (the logic is `inference::eval::evaluate`; this file parses and prints). The model
 //! selection curves go to stderr. With `--json`, stdout is exactly one JSON object
-//! `{"rows":[{"window":W,"crf":X,"hmm":Y,"prior":Z,"gain":G,"gain_se":E,"l2":L,"lag_penalty":P}, ...],
-//! "states":S,"clusters":K,"train_steps":N,"test_steps":M}` (plus `"ari":[train,test]` on a
-//! synthetic corpus); progress and extras go to stderr.
+//! `{"rows":[{"window":W,"crf":X,"hmm":Y,"prior":Z,"gain":G,"gain_se":E,"crf_hmm_se":H,
+//! "take_prior":T,"take_gain":TG,"take_gain_se":TE,"l2":L,"lag_penalty":P}, ...],
+//! "states":S,"clusters":K,"train_steps":N,"test_steps":M,"raw_offset":R}` (plus
+//! `"ari":[train,test]` on a synthetic corpus); progress and extras go to stderr. The take
+//! prior and `raw_offset` are described in `inference::eval`: the gain over the take prior is
+//! what speech says within a take (with several training takes the gain over the prior also
+//! counts telling them apart), and `crf + raw_offset` compares across training corpora and
+//! `--take-level`.
+//!
+//! **Leave one take out**: `--train A --test B` (a take outside the training takes is
+//! standardized by its own level, as a library is). **Pooled or alone** on a held-out span of
+//! a take: `--folds N --test A` with `--train A` or `--train A B`, compared by
+//! `crf + raw_offset` or the take gain, not by the gain (the two models' priors differ).
 //!
 //! When a training folder holds a synthetic corpus's `truth.json`, the adjusted Rand index
 //! between the HMM's most likely states and the planted states is reported too.
@@ -16,7 +26,8 @@
 //! `inference::train::cv_split`), model selection included. Rows are means over all held-out
 //! steps; the gain's standard error comes from the spread of the folds' gains, and each
 //! fold's gain is printed (`fold_gains` in the JSON, with every fold's report under
-//! `folds`). One split is one draw: on the 9-joint take (4 folds, W = 4) the folds' gains
+//! `folds`), and likewise `crf - hmm` (`crf_hmm`, `crf_hmm_se`, `fold_crf_hmm`) and the take
+//! gain (`take_prior`, `take_gain`, `take_gain_se`); `raw_offset` is the folds'. One split is one draw: on the 9-joint take (4 folds, W = 4) the folds' gains
 //! range over +0.36 to +0.40.
 
 use std::collections::HashMap;
@@ -26,7 +37,7 @@ use super::args::{parse_span, CorpusArgs, ModelArgs};
 use super::CliError;
 use crate::corpus::load_corpus;
 use crate::inference::eval::{self, CvReport, EvalReport, PlantedRuns};
-use crate::inference::train::{cv_split, sequences, sequences_with_levels, take_levels};
+use crate::inference::train::{cv_split_levels, pooled_levels, sequences_with_levels, take_levels};
 
 /// Arguments of `eval-inference`.
 #[derive(Debug, clap::Args)]
@@ -51,6 +62,12 @@ pub struct EvalArgs {
     /// Use only test steps in START:END seconds of each take.
     #[arg(long, value_parser = parse_span)]
     pub test_span: Option<(f64, f64)>,
+    /// How each take's log kinematic parameters are standardized before the model's
+    /// normalization: by the take's own level (`own`, as `fit` does) or all takes alike by the
+    /// level of every training segment together (`pooled`, as before takes had levels of their
+    /// own; a test take outside the training takes gets that level too).
+    #[arg(long, value_enum, default_value_t = TakeLevel::Own)]
+    pub take_level: TakeLevel,
     /// Print exactly one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -60,6 +77,15 @@ pub struct EvalArgs {
     /// Corpus loading options.
     #[command(flatten)]
     pub load: CorpusArgs,
+}
+
+/// How takes are standardized (`--take-level`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TakeLevel {
+    /// Each take by its own level.
+    Own,
+    /// Every take by the level of all training segments together.
+    Pooled,
 }
 
 /// Planted state runs per take stem, from a `truth.json` next to the inputs.
@@ -98,9 +124,20 @@ pub fn evaluate(a: &EvalArgs) -> Result<EvalReport, CliError> {
     } else {
         load_corpus(&a.test, &opts)?
     };
-    let (train_seqs, segs) = sequences(&train, a.train_span);
     // A test span of a training take is standardized by the training span's level.
-    let levels = take_levels(&train, a.train_span);
+    let levels = match a.take_level {
+        TakeLevel::Own => take_levels(&train, a.train_span),
+        TakeLevel::Pooled => {
+            let mut levels = pooled_levels(&train, a.train_span);
+            if let Some(&pooled) = levels.values().next() {
+                for t in &test.takes {
+                    levels.entry(t.stem.clone()).or_insert(pooled);
+                }
+            }
+            levels
+        }
+    };
+    let (train_seqs, segs) = sequences_with_levels(&train, a.train_span, &levels);
     let (test_seqs, _) = sequences_with_levels(&test, a.test_span, &levels);
     let cfg = a.model.config(selection_window(a));
     let (train_runs, test_runs) = (planted_runs(&a.train), planted_runs(&a.test));
@@ -150,7 +187,15 @@ pub fn cross_validate(a: &EvalArgs) -> Result<CvReport, CliError> {
         stems
     };
     let splits: Vec<_> = (0..folds)
-        .map(|k| cv_split(&train, k, folds, |stem| held.iter().any(|h| h == stem)))
+        .map(|k| {
+            cv_split_levels(
+                &train,
+                k,
+                folds,
+                |stem| held.iter().any(|h| h == stem),
+                a.take_level == TakeLevel::Own,
+            )
+        })
         .collect();
     let cfg = a.model.config(selection_window(a));
     Ok(eval::cross_validate(&splits, &cfg, &a.windows, &|line| {
@@ -181,30 +226,63 @@ fn run_folds(a: &EvalArgs) -> Result<(), CliError> {
     }
     outln!("mean log-likelihood per held-out step of the true kinematic parameters, all folds")?;
     outln!(
-        "{:>6} {:>10} {:>10} {:>10} {:>10} {:>7}  {}",
+        "{:>6} {:>9} {:>9} {:>9} {:>8} {:>6} {:>8} {:>6} {:>9} {:>6}  {}",
         "window",
         "crf",
         "hmm",
         "prior",
         "gain",
         "+-se",
+        "crf-hmm",
+        "+-se",
+        "take-gain",
+        "+-se",
         "gain per fold"
     )?;
     for w in &r.rows {
         let per: Vec<String> = w.fold_gains.iter().map(|g| format!("{g:+.3}")).collect();
         outln!(
-            "{:>6} {:>10.3} {:>10.3} {:>10.3} {:>+10.3} {:>7.3}  {}",
+            "{:>6} {:>9.3} {:>9.3} {:>9.3} {:>+8.3} {:>6.3} {:>+8.3} {:>6.3} {:>+9.3} {:>6.3}  {}",
             w.window,
             w.crf,
             w.hmm,
             w.prior,
             w.gain,
             w.gain_se,
+            w.crf_hmm,
+            w.crf_hmm_se,
+            w.take_gain,
+            w.take_gain_se,
             per.join(" ")
         )?;
     }
+    let per: Vec<String> = r
+        .rows
+        .iter()
+        .map(|w| {
+            let d: Vec<String> = w.fold_crf_hmm.iter().map(|g| format!("{g:+.3}")).collect();
+            format!("W={}: {}", w.window, d.join(" "))
+        })
+        .collect();
+    outln!("crf-hmm per fold: {}", per.join("; "))?;
+    outln!(
+        "{}",
+        raw_line(r.raw_offset, r.rows.iter().map(|w| (w.window, w.crf)))
+    )?;
     outln!("{extras}")?;
     Ok(())
+}
+
+/// The CRF's scores as log-densities of the log kinematic parameters themselves.
+fn raw_line(offset: f64, crf: impl Iterator<Item = (usize, f64)>) -> String {
+    let v: Vec<String> = crf
+        .map(|(w, c)| format!("W={w} {:.3}", c + offset))
+        .collect();
+    format!(
+        "crf as log-density of the log kinematic parameters (scores {offset:+.3}; compares \
+         across training corpora and --take-level): {}",
+        v.join(", ")
+    )
 }
 
 /// Runs the command.
@@ -236,29 +314,41 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     }
     outln!("mean log-likelihood per test step of the true kinematic parameters")?;
     outln!(
-        "{:>6} {:>10} {:>10} {:>10} {:>10} {:>7} {:>8} {:>6}",
+        "{:>6} {:>9} {:>9} {:>9} {:>8} {:>6} {:>8} {:>6} {:>9} {:>6} {:>7} {:>5}",
         "window",
         "crf",
         "hmm",
         "prior",
         "gain",
         "+-se",
+        "crf-hmm",
+        "+-se",
+        "take-gain",
+        "+-se",
         "l2",
         "lag"
     )?;
     for w in &r.rows {
         outln!(
-            "{:>6} {:>10.3} {:>10.3} {:>10.3} {:>+10.3} {:>7.3} {:>8} {:>6}",
+            "{:>6} {:>9.3} {:>9.3} {:>9.3} {:>+8.3} {:>6.3} {:>+8.3} {:>6.3} {:>+9.3} {:>6.3} {:>7} {:>5}",
             w.window,
             w.crf,
             w.hmm,
             w.prior,
             w.gain,
             w.gain_se,
+            w.crf - w.hmm,
+            w.crf_hmm_se,
+            w.take_gain,
+            w.take_gain_se,
             w.l2,
             w.lag_penalty
         )?;
     }
+    outln!(
+        "{}",
+        raw_line(r.raw_offset, r.rows.iter().map(|w| (w.window, w.crf)))
+    )?;
     outln!("{extras}")?;
     Ok(())
 }

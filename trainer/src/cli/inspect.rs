@@ -63,7 +63,7 @@ pub fn summary(b: &Blob<'_>) -> String {
     let t = b.timing();
     let _ = writeln!(
         s,
-        "control: decisions {}; a cut decided mid-segment waits up to {} ms for the hands to pause",
+        "control: decisions {}; a cut decided mid-segment waits for the hands' calmest pause within {} ms",
         if t.sync_to_onsets {
             format!(
                 "on syllable onsets (within {} ms; a segment end waits up to {} ms)",
