@@ -13,7 +13,18 @@
 //!   emission re-fitted as a full-covariance Gaussian over the *windowed prosody vector*
 //!   (per step of the window: relative log F0 with 0 when unvoiced, a voiced flag, relative
 //!   intensity, log length), weighted by the kinematic posteriors; beliefs by its forward pass;
-//! - **prior**: the state frequencies, no input.
+//! - **prior**: the state frequencies, no input;
+//! - **take prior**: the state frequencies of the test step's own take on its training steps
+//!   (the prior for a take the model was not trained on). With several training takes whose
+//!   kinematics differ, telling one take from another is most of what speech can tell about
+//!   the states (it can be told from the style of the speech), and the gain over the prior
+//!   counts it; the gain over the take prior counts only what speech says within a take.
+//!
+//! Per window, besides each score: the CRF's gain over the prior and over the take prior, and
+//! `crf - hmm`, each with the standard error of the per-step differences. The scores are
+//! densities of the normalized targets, which depend on the training corpus and on how takes
+//! are standardized; `raw_offset` turns them into densities of the log kinematic parameters
+//! themselves, which compare models trained on different corpora on the same test steps.
 //!
 //! Also the adjusted Rand index between two labelings (hand-written: a dozen lines of
 //! contingency counting, not worth a dependency).
@@ -24,7 +35,7 @@ use std::time::Instant;
 use gesture_runtime::inference::{StepFeatures, MAX_WINDOW};
 use serde::Serialize;
 
-use super::crf::Crf;
+use super::crf::{Crf, TrainSeq};
 use super::gaussian::{log_sum_exp, Gaussian};
 use super::hmm::Seq;
 use super::select::{self, Selection};
@@ -49,6 +60,19 @@ pub struct Row {
     /// square root of the test steps (steps are correlated in time, so this is a lower bound
     /// on the uncertainty).
     pub gain_se: f64,
+    /// Standard error of `crf - hmm`, per step paired like `gain_se`: Fig. 4's ordering on
+    /// these test steps is `crf - hmm` in units of it.
+    pub crf_hmm_se: f64,
+    /// The take prior: the belief fixed at the state frequencies of the test step's own take
+    /// on its training steps (the model's prior for a take it was not trained on). The gain
+    /// over the model's prior also counts telling one training take's states from another's,
+    /// which speech can do across recordings of different style; over the take prior it
+    /// counts only what speech says within a take.
+    pub take_prior: f64,
+    /// `crf - take_prior` (nats per step).
+    pub take_gain: f64,
+    /// Standard error of `take_gain`, per step paired.
+    pub take_gain_se: f64,
     /// CRF L2 strength per training step used for this window.
     pub l2: f64,
     /// CRF lag penalty used for this window.
@@ -71,6 +95,13 @@ pub struct EvalReport {
     pub train_steps: usize,
     /// Test steps.
     pub test_steps: usize,
+    /// What to add to the `crf`, `hmm` and `prior` scores for the log-density of the test
+    /// steps' log kinematic parameters themselves, before their take's level and the model's
+    /// normalization (the mean over test steps of the log-determinant of that affine map).
+    /// The normalized targets depend on the training corpus and on how takes are
+    /// standardized; these log-densities do not, so they compare models trained on different
+    /// corpora on the same test steps.
+    pub raw_offset: f64,
     /// Adjusted Rand index of the HMM's states against planted ones on the training and test
     /// data, when known.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -101,6 +132,18 @@ pub struct CvRow {
     pub gain_se: f64,
     /// Each fold's gain.
     pub fold_gains: Vec<f64>,
+    /// `crf - hmm` over all test steps.
+    pub crf_hmm: f64,
+    /// Its standard error from the folds' differences.
+    pub crf_hmm_se: f64,
+    /// Each fold's `crf - hmm`.
+    pub fold_crf_hmm: Vec<f64>,
+    /// The take prior (see [`Row::take_prior`]) over all test steps.
+    pub take_prior: f64,
+    /// `crf - take_prior` over all test steps.
+    pub take_gain: f64,
+    /// Its standard error from the folds' take gains.
+    pub take_gain_se: f64,
 }
 
 /// A cross-validation over time: every fold's report and the windows' figures over all.
@@ -108,6 +151,8 @@ pub struct CvRow {
 pub struct CvReport {
     /// One row per window.
     pub rows: Vec<CvRow>,
+    /// [`EvalReport::raw_offset`] over all folds' test steps.
+    pub raw_offset: f64,
     /// Each fold's evaluation (its model selection included).
     pub folds: Vec<EvalReport>,
     /// Wall time (s).
@@ -159,31 +204,50 @@ pub fn cross_validate(
                     .sum::<f64>()
                     / steps
             };
-            let fold_gains: Vec<f64> = folds.iter().map(|f| f.rows[i].gain).collect();
-            let n = fold_gains.len() as f64;
-            let m = fold_gains.iter().sum::<f64>() / n.max(1.0);
-            let gain_se = if fold_gains.len() < 2 {
-                0.0
-            } else {
-                (fold_gains.iter().map(|g| (g - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
-            };
-            let (crf, prior) = (pooled(|r| r.crf), pooled(|r| r.prior));
+            let per_fold =
+                |v: fn(&Row) -> f64| -> Vec<f64> { folds.iter().map(|f| v(&f.rows[i])).collect() };
+            let fold_gains = per_fold(|r| r.gain);
+            let fold_crf_hmm = per_fold(|r| r.crf - r.hmm);
+            let (crf, hmm, prior) = (pooled(|r| r.crf), pooled(|r| r.hmm), pooled(|r| r.prior));
+            let take_prior = pooled(|r| r.take_prior);
             CvRow {
                 window,
                 crf,
-                hmm: pooled(|r| r.hmm),
+                hmm,
                 prior,
                 gain: crf - prior,
-                gain_se,
+                gain_se: spread_se(&fold_gains),
+                crf_hmm: crf - hmm,
+                crf_hmm_se: spread_se(&fold_crf_hmm),
+                fold_crf_hmm,
+                take_prior,
+                take_gain: crf - take_prior,
+                take_gain_se: spread_se(&per_fold(|r| r.take_gain)),
                 fold_gains,
             }
         })
         .collect();
+    let raw_offset = folds
+        .iter()
+        .map(|f| f.raw_offset * f.test_steps as f64)
+        .sum::<f64>()
+        / steps;
     Ok(CvReport {
         rows,
+        raw_offset,
         folds,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The standard error of the mean of `v` from its spread (0 with fewer than two values).
+fn spread_se(v: &[f64]) -> f64 {
+    if v.len() < 2 {
+        return 0.0;
+    }
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    (v.iter().map(|g| (g - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt()
 }
 
 /// Fits on `train` (S and K chosen once with window `cfg.window` when open), then for each of
@@ -224,6 +288,8 @@ pub fn evaluate(
     let y_test = normalized(test, &base.normalization);
     let prior_steps = step_scores(&base, &y_test, &prior_beliefs(&base, test));
     let prior = mean(&prior_steps);
+    let take_steps = step_scores(&base, &y_test, &take_prior_beliefs(&base, train_seqs, test));
+    let take_prior = mean(&take_steps);
     let mut rows = Vec::new();
     for (&w, &(l2, lag)) in windows.iter().zip(&choice.regularization) {
         let crf = fit_crf(&base, w, l2, lag, &mut report, log)?;
@@ -231,13 +297,18 @@ pub fn evaluate(
         let crf_score = mean(&crf_steps);
         let brand = RemappedHmm::fit(&base, train_seqs, w);
         let hb: Vec<Vec<Vec<f64>>> = test.iter().map(|s| brand.beliefs(&base, s)).collect();
+        let hmm_steps = step_scores(&base, &y_test, &hb);
         rows.push(Row {
             window: w,
             crf: crf_score,
-            hmm: mean_score(&base, &y_test, &hb),
+            hmm: mean(&hmm_steps),
             prior,
             gain: crf_score - prior,
             gain_se: standard_error(&crf_steps, &prior_steps),
+            crf_hmm_se: standard_error(&crf_steps, &hmm_steps),
+            take_prior,
+            take_gain: crf_score - take_prior,
+            take_gain_se: standard_error(&crf_steps, &take_steps),
             l2,
             lag_penalty: lag,
         });
@@ -253,10 +324,32 @@ pub fn evaluate(
         clusters: choice.clusters,
         train_steps: report.steps,
         test_steps,
+        raw_offset: raw_offset(&base, test),
         ari,
         selection: choice.selection,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// [`EvalReport::raw_offset`]: the mean over the steps of `seqs` of `ln |det|` of the map from
+/// log kinematic parameters to the model's targets (each take's level, then the model's
+/// normalization: `-sum_d ln(level_scale_d * scale_d)`).
+pub fn raw_offset(base: &FitBase, seqs: &[Sequence]) -> f64 {
+    let steps: usize = seqs.iter().map(Sequence::len).sum();
+    let sum: f64 = seqs
+        .iter()
+        .map(|s| {
+            let log_det: f64 = s
+                .level
+                .scale
+                .iter()
+                .zip(&base.normalization.scale)
+                .map(|(a, b)| -(a * b).ln())
+                .sum();
+            log_det * s.len() as f64
+        })
+        .sum();
+    sum / steps.max(1) as f64
 }
 
 /// ARI between the HMM's states (argmax posterior) and the planted states at step midpoints.
@@ -335,6 +428,48 @@ pub fn crf_beliefs(base: &FitBase, crf: &Crf, seqs: &[Sequence]) -> Vec<Vec<Vec<
 pub fn prior_beliefs(base: &FitBase, seqs: &[Sequence]) -> Vec<Vec<Vec<f64>>> {
     seqs.iter()
         .map(|s| vec![base.state_prior.clone(); s.len()])
+        .collect()
+}
+
+/// Each training take's state frequencies: the mean HMM posterior over its training steps
+/// (`posteriors` holds one [`TrainSeq`] per sequence of `train`, as [`FitBase::train`] does).
+pub fn take_state_frequencies(
+    train: &[Sequence],
+    posteriors: &[TrainSeq],
+    states: usize,
+) -> HashMap<String, Vec<f64>> {
+    let mut sums: HashMap<String, (Vec<f64>, f64)> = HashMap::new();
+    for (s, q) in train.iter().zip(posteriors) {
+        let (f, n) = sums
+            .entry(s.stem.clone())
+            .or_insert_with(|| (vec![0.0; states], 0.0));
+        for g in q.gamma.chunks_exact(states.max(1)) {
+            f.iter_mut().zip(g).for_each(|(a, b)| *a += b);
+            *n += 1.0;
+        }
+    }
+    sums.into_iter()
+        .filter(|(_, (_, n))| *n > 0.0)
+        .map(|(stem, (f, n))| (stem, f.iter().map(|v| v / n).collect()))
+        .collect()
+}
+
+/// The take prior at every step ([`Row::take_prior`]): the state frequencies of the training
+/// steps of the sequence's own take, or the model's prior for a take without training steps.
+pub fn take_prior_beliefs(
+    base: &FitBase,
+    train: &[Sequence],
+    seqs: &[Sequence],
+) -> Vec<Vec<Vec<f64>>> {
+    let freq = take_state_frequencies(train, &base.train, base.hmm.states());
+    seqs.iter()
+        .map(|s| {
+            let b = freq
+                .get(&s.stem)
+                .cloned()
+                .unwrap_or_else(|| base.state_prior.clone());
+            vec![b; s.len()]
+        })
         .collect()
 }
 
@@ -473,6 +608,39 @@ mod tests {
         // expected = 18/15 = 1.2; max = 4.5; ARI = 0.8 / 3.3.
         let v = adjusted_rand_index(&[0, 0, 0, 1, 1, 1], &[0, 0, 1, 1, 2, 2]);
         assert!((v - 0.8 / 3.3).abs() < 1e-12, "{v}");
+    }
+
+    #[test]
+    fn take_frequencies_average_each_takes_posteriors() {
+        let seq = |stem: &str, n: usize| Sequence {
+            stem: stem.into(),
+            features: vec![
+                StepFeatures {
+                    f0: None,
+                    obs: [0.0, 0.0],
+                    pause: false,
+                };
+                n
+            ],
+            ..Sequence::default()
+        };
+        let post = |gamma: Vec<f64>| TrainSeq {
+            memberships: Vec::new(),
+            gamma,
+            xi_sum: Vec::new(),
+        };
+        // Take a in two pieces (3 steps, 1 step), take b in one; two states.
+        let train = [seq("a", 3), seq("b", 2), seq("a", 1)];
+        let posts = [
+            post(vec![1.0, 0.0, 1.0, 0.0, 0.5, 0.5]),
+            post(vec![0.0, 1.0, 0.2, 0.8]),
+            post(vec![0.5, 0.5]),
+        ];
+        let f = take_state_frequencies(&train, &posts, 2);
+        assert_eq!(f.len(), 2);
+        assert!((f["a"][0] - 3.0 / 4.0).abs() < 1e-12, "{f:?}");
+        assert!((f["a"][1] - 1.0 / 4.0).abs() < 1e-12, "{f:?}");
+        assert!((f["b"][0] - 0.1).abs() < 1e-12 && (f["b"][1] - 0.9).abs() < 1e-12);
     }
 
     #[test]

@@ -107,6 +107,24 @@ pub fn take_levels(corpus: &Corpus, span: Option<(f64, f64)>) -> HashMap<String,
         .collect()
 }
 
+/// Every take's level as one: the level of all takes' segments inside `span` together (each
+/// take standardized alike, so the corpus normalization alone puts them in the model's
+/// terms, as before takes had levels of their own; `eval-inference --take-level pooled`).
+pub fn pooled_levels(corpus: &Corpus, span: Option<(f64, f64)>) -> HashMap<String, Normalization> {
+    let inside = in_span(span);
+    let all: Vec<[f64; 6]> = corpus
+        .takes
+        .iter()
+        .flat_map(|t| take_segments(t, &inside).into_iter().map(|g| g.2))
+        .collect();
+    let pooled = level_of(&all, Normalization::identity());
+    corpus
+        .takes
+        .iter()
+        .map(|t| (t.stem.clone(), pooled))
+        .collect()
+}
+
 /// The sequences of a corpus, keeping steps whose midpoint lies in `span` (seconds), and the
 /// log kinematic vectors of the segments inside the span (for the normalization), each take
 /// standardized by its level ([`take_levels`] over the same span).
@@ -186,6 +204,18 @@ pub fn cv_split(
     folds: usize,
     held: impl Fn(&str) -> bool,
 ) -> CvSplit {
+    cv_split_levels(corpus, fold, folds, held, true)
+}
+
+/// [`cv_split`], with `own_levels` false every take standardized by the level of all training
+/// segments together ([`pooled_levels`]) instead of its own.
+pub fn cv_split_levels(
+    corpus: &Corpus,
+    fold: usize,
+    folds: usize,
+    held: impl Fn(&str) -> bool,
+    own_levels: bool,
+) -> CvSplit {
     let mut out = CvSplit::default();
     let folds = folds.max(1);
     // Each take is standardized by the level of its training segments (the held-out span's
@@ -230,7 +260,11 @@ pub fn cv_split(
     let pooled = level_of(&all, Normalization::identity());
     for (t, segs, lo, hi, plo, phi) in parts {
         let train_segs = trained(&segs, plo, phi);
-        let level = level_of(&train_segs, pooled);
+        let level = if own_levels {
+            level_of(&train_segs, pooled)
+        } else {
+            pooled
+        };
         let is_held = |a: f64, b: f64| {
             let mid = 0.5 * (a + b);
             mid >= lo && mid < hi
