@@ -911,10 +911,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         let last = f.saturating_add(window).min(len.saturating_sub(1));
         let mut beat = None;
         for g in f + 1..=last {
-            if self.lib.is_calm(c, g) {
+            let (calm, is_beat) = self.lib.calm_beat(c, g);
+            if calm {
                 return Some(g);
             }
-            if beat.is_none() && self.lib.is_beat(c, g) {
+            if beat.is_none() && is_beat {
                 beat = Some(g);
             }
         }

@@ -145,6 +145,11 @@ pub trait LibraryFrames {
     fn is_calm(&self, _c: usize, _f: usize) -> bool {
         false
     }
+    /// `(is_calm(c, f), is_beat(c, f))` at once (an implementation may read both with one
+    /// lookup).
+    fn calm_beat(&self, c: usize, f: usize) -> (bool, bool) {
+        (self.is_calm(c, f), self.is_beat(c, f))
+    }
     /// Rotation groups (three channels holding one rotation as Euler angles).
     fn group_count(&self) -> usize {
         0
