@@ -88,6 +88,10 @@ impl LibraryFrames for Lib {
     fn is_calm(&self, c: usize, _f: usize) -> bool {
         ENERGY[c] < 0.0
     }
+    /// The gestures' hands pause every 8 frames (their speed's local minima).
+    fn is_beat(&self, _c: usize, f: usize) -> bool {
+        f % 8 == 7
+    }
 }
 
 /// Syllables at 3.5 Hz while `speaking(t)`, silence otherwise (16 kHz).
