@@ -994,8 +994,15 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             self.ms_ticks(self.variety.recency_ms),
             self.ms_ticks(self.variety.usage_ms),
         );
+        // While speaking, a tone the user chose sets the body's energy: the voice's energy
+        // weight acts on the neutral share of the style (all of it by default).
+        let share = if self.voice.resting() {
+            1.0
+        } else {
+            self.style.neutral()
+        };
         penalties.set_voice(
-            self.voice.weight(&self.follow),
+            share * self.voice.weight(&self.follow),
             self.rest.extras(),
             self.rest.energy(),
             self.voice.resting(),

@@ -45,6 +45,12 @@
 //!   ([`MIN_RATE`](crate::player::MIN_RATE)), interpolated between frames: a calm motion at
 //!   half speed reads as breathing and drift, not as slow motion.
 //!
+//! - **a tone** the user chose (`policy::Style`) sets the body's energy while speaking: the
+//!   speaking terms are scaled by the style's neutral weight (1 by default; 0 under `sad=1`),
+//!   or they would override it (the rest penalty alone forbids the calm segments a sad tone
+//!   wants: on new speech, sad motion went from half the neutral hand speed to 0.96 of it).
+//!   Resting in the pauses stays the voice's.
+//!
 //! The belief still chooses among segments of like energy, and the variety costs still apply
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
 //! `f32` on values read from the blob, the same on host and device; the state is a few bytes.
