@@ -99,7 +99,7 @@ pub const REST_SET: usize = 6;
 /// The calmest of those, candidates at every exit point while resting (each candidate costs a
 /// dot product per value table mixed: six under a three-tone style took the worst decision
 /// past 50 k instructions on a Cortex-M4F).
-pub const REST_EXTRAS: usize = 4;
+pub const REST_EXTRAS: usize = 3;
 
 /// Voice level (the step feature, 10 dB units) at which the energy weight is full.
 pub const VOICE_SPAN: f32 = 0.5;
@@ -368,7 +368,7 @@ mod tests {
         ]);
         let r = RestSet::of(&big, 14);
         assert_eq!(r.segments(), &[3, 1, 4, 7, 5, 0]);
-        assert_eq!((r.extras(), r.energy()), (&[3u16, 1, 4, 7][..], 0.5));
+        assert_eq!((r.extras(), r.energy()), (&[3u16, 1, 4][..], 0.5));
         assert_eq!(RestSet::of(&t, 0).segments(), &[] as &[u16]);
     }
 }
