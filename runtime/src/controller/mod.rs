@@ -60,6 +60,8 @@
 //! written where they stay, so construction needs only a few KiB of stack beyond the controller
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
+mod labels;
+
 use crate::blob::Blob;
 use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
 use crate::inference::{
@@ -71,69 +73,9 @@ use crate::policy::{
     StyleError, Variety, Visit,
 };
 
-/// Most semantic labels a blob defines.
-pub const MAX_LABELS: usize = 16;
-/// Most segments of a blob that carry a label.
-pub const MAX_LABELLED: usize = 64;
-/// Labels that can wait behind the one being served.
-pub const LABEL_QUEUE: usize = 4;
+use labels::ActiveLabel;
+pub use labels::{LabelError, LabelOutcome, LABEL_QUEUE, MAX_LABELLED, MAX_LABELS};
 
-/// Why a label was refused.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LabelError {
-    /// The blob has no label with this index.
-    Unknown {
-        /// The index given.
-        label: u32,
-        /// Labels of the blob.
-        labels: u32,
-    },
-    /// [`LABEL_QUEUE`] labels already wait.
-    QueueFull,
-}
-
-impl core::fmt::Display for LabelError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match *self {
-            Self::Unknown { label, labels } => {
-                write!(f, "label {label} is not one of the blob's {labels} labels")
-            }
-            Self::QueueFull => write!(f, "{LABEL_QUEUE} labels already wait"),
-        }
-    }
-}
-
-impl core::error::Error for LabelError {}
-
-/// What became of a label ([`ControllerEvent::Label`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LabelOutcome {
-    /// The label reached the controller (it waits for the next exit point).
-    Received,
-    /// A segment carrying it was entered (at `frame`), or was already playing before its
-    /// stroke.
-    Entered {
-        /// The segment.
-        segment: usize,
-        /// The frame it was entered at.
-        frame: usize,
-    },
-    /// The stroke frame of that segment played: the label is served.
-    Stroke,
-    /// It waited longer than the blob's timeout and was dropped.
-    TimedOut,
-}
-
-/// The label being served.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct ActiveLabel {
-    /// Label index (0-based).
-    label: u8,
-    /// Tick it became active.
-    since: u64,
-    /// The segment entered for it and its stroke frame, once entered.
-    serving: Option<(usize, usize)>,
-}
 use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
 
 /// When the controller decides at exit points (see the module docs).
@@ -523,126 +465,6 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
     /// The style in force.
     pub fn style(&self) -> &Style {
         &self.style
-    }
-
-    /// Asks for the semantic label `label` (0-based, the blob's order; docs/method.md
-    /// "Semantic labels"): from the next exit point on, the controller prefers the segments
-    /// carrying it and may enter one just before its stroke; the label is served once that
-    /// stroke plays, or dropped after the blob's timeout. A label that arrives while another
-    /// is served waits (at most [`LABEL_QUEUE`]). Reports `Received` through the next call's
-    /// events.
-    pub fn push_label(&mut self, label: usize) -> Result<(), LabelError> {
-        let labels = self.tables.labels();
-        if label >= labels {
-            return Err(LabelError::Unknown {
-                label: label.min(u32::MAX as usize) as u32,
-                labels: labels as u32,
-            });
-        }
-        if self.active_label.is_none() {
-            self.activate(label as u8);
-            Ok(())
-        } else {
-            self.label_queue
-                .push_back(label as u8)
-                .map_err(|_| LabelError::QueueFull)
-        }
-    }
-
-    /// Drops the label being served and every waiting one.
-    pub fn clear_labels(&mut self) {
-        self.active_label = None;
-        self.label_queue.clear();
-    }
-
-    /// The label being served (0-based), if any.
-    pub fn active_label(&self) -> Option<usize> {
-        self.active_label.map(|a| a.label as usize)
-    }
-
-    fn activate(&mut self, label: u8) {
-        self.active_label = Some(ActiveLabel {
-            label,
-            since: self.ticks,
-            serving: None,
-        });
-        self.label_received = true;
-    }
-
-    /// Whether a label waits for a segment (decisions then come at once).
-    fn label_waiting(&self) -> bool {
-        self.active_label.is_some_and(|a| a.serving.is_none())
-    }
-
-    /// Label bookkeeping after a tick that played `frame` of `segment` (`tick`): announces a
-    /// new label, serves it with the segment already playing if that carries it before its
-    /// stroke, reports its stroke or its timeout, and moves on to the next waiting label.
-    fn labels_after_tick(
-        &mut self,
-        tick: u64,
-        segment: usize,
-        frame: usize,
-        sink: &mut impl FnMut(ControllerEvent<'_>),
-    ) {
-        let Some(mut a) = self.active_label else {
-            return;
-        };
-        let label = a.label as usize;
-        if self.label_received {
-            self.label_received = false;
-            sink(ControllerEvent::Label {
-                tick: a.since,
-                label,
-                outcome: LabelOutcome::Received,
-            });
-            if self.tables.label_of(segment) == a.label + 1 {
-                if let Some(stroke) = self.tables.stroke_of(segment).filter(|&s| s >= frame) {
-                    a.serving = Some((segment, stroke));
-                    sink(ControllerEvent::Label {
-                        tick,
-                        label,
-                        outcome: LabelOutcome::Entered { segment, frame },
-                    });
-                }
-            }
-        }
-        let done = match a.serving {
-            Some((seg, stroke)) if seg == segment && frame >= stroke => {
-                sink(ControllerEvent::Label {
-                    tick,
-                    label,
-                    outcome: LabelOutcome::Stroke,
-                });
-                true
-            }
-            // The segment was left before its stroke (a cut decided for another reason):
-            // the label waits again.
-            Some((seg, _)) if seg != segment => {
-                a.serving = None;
-                false
-            }
-            Some(_) => false,
-            None => {
-                let timeout = self.ms_ticks(self.label_timeout_ms) as u64;
-                if timeout > 0 && tick.saturating_sub(a.since) >= timeout {
-                    sink(ControllerEvent::Label {
-                        tick,
-                        label,
-                        outcome: LabelOutcome::TimedOut,
-                    });
-                    true
-                } else {
-                    false
-                }
-            }
-        };
-        self.active_label = Some(a);
-        if done {
-            self.active_label = None;
-            if let Some(next) = self.label_queue.pop_front() {
-                self.activate(next);
-            }
-        }
     }
 
     /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
