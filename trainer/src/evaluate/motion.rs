@@ -36,7 +36,9 @@
 //!
 //! **Regret of variety.** For every decision of the online run, the float, unpruned policy's
 //! expected cost of the choice made is compared with the best choice under the same belief
-//! (variety costs excluded): `variety_regret` is the excess over the best, as a fraction.
+//! (variety costs and voice terms excluded): `variety_regret` is the excess over the best, as a
+//! fraction; it counts what the variety costs and following the voice give up of the paper's
+//! objective.
 
 use std::path::PathBuf;
 
