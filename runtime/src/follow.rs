@@ -23,7 +23,9 @@
 //!   begins the controller decides at the playing segment's next exit point without waiting
 //!   for it: the cut then waits, as every mid-segment cut does, for the next pause of the hands
 //!   (`defer_cut_ms`), so the playing gesture is left between strokes. The rest motion is the
-//!   library's own: its calmest segments, breathing and drifting as the capture did.
+//!   library's own: its calmest segments, breathing and drifting as the capture did; once one
+//!   is entered it holds until the speech returns, played to and fro (the player turns at its
+//!   ends: no cut, no freeze).
 //! - **speaking**: `w = -energy_cost * clamp(level / VOICE_SPAN, -1, 1)`, `level` the last
 //!   syllable's intensity relative to the speaker's running level (the CRF's own step feature,
 //!   in 10 dB units): louder than usual favours energetic segments, quieter calm ones. And the
@@ -37,19 +39,17 @@
 //!   voice level counts as `+VOICE_SPAN` until the first syllable is measured (speech out of
 //!   silence is as loud as it gets relative to it). The chosen segment is entered at its
 //!   first frame: a preparation, not a stroke.
-//!
 //! - **the rest's pace**: a library with no true rest (a monologue's capture: the calmest
 //!   segments of the shared 067 take move at 0.4 of its median hand speed) would still gesture
 //!   in the pauses. While resting, a segment faster than [`REST_SPEED`] of the library's median
 //!   plays slower in proportion ([`rest_rate`]), at least at half its pace
 //!   ([`MIN_RATE`](crate::player::MIN_RATE)), interpolated between frames: a calm motion at
 //!   half speed reads as breathing and drift, not as slow motion.
-//!
 //! - **a tone** the user chose (`policy::Style`) sets the body's energy while speaking: the
-//!   speaking terms are scaled by the style's neutral weight (1 by default; 0 under `sad=1`),
-//!   or they would override it (the rest penalty alone forbids the calm segments a sad tone
-//!   wants: on new speech, sad motion went from half the neutral hand speed to 0.96 of it).
-//!   Resting in the pauses stays the voice's.
+//!   speaking energy weight is scaled by the style's neutral weight (1 by default; 0 under
+//!   `sad=1`), or it would override the tone (on new speech, sad motion kept 0.96 of the
+//!   neutral hand speed; scaled, 0.63). The rest penalty and resting stay the voice's: without
+//!   the penalty every tone brought the rests into speech.
 //!
 //! The belief still chooses among segments of like energy, and the variety costs still apply
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
