@@ -128,8 +128,6 @@ struct Deferred {
     /// The segment to cut to and its entry frame.
     segment: usize,
     frame: usize,
-    /// Ticks waited.
-    waited: u64,
     /// The playing segment's frame where its hands next pause, if one comes within the
     /// window (else: the first beat, calm or last frame that comes).
     at: Option<(usize, usize)>,
@@ -284,7 +282,7 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     waiting: Option<usize>,
     /// Ticks waited at it.
     waited: u64,
-    /// A cut decided and waiting for the hands to pause: segment, entry frame, ticks waited.
+    /// A cut decided and waiting for the hands to pause.
     deferred: Option<Deferred>,
     /// How the character follows the voice.
     follow: VoiceFollow,
@@ -627,7 +625,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             return;
         }
         let t = self.timing;
-        if let Some(mut d) = self.deferred {
+        if let Some(d) = self.deferred {
             let pause = match d.at {
                 Some((s, f)) if s == segment => played >= f,
                 _ => self.hands_pause(segment, played),
@@ -635,9 +633,6 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             if pause {
                 self.deferred = None;
                 self.cut(d.segment, d.frame, tick);
-            } else {
-                d.waited += 1;
-                self.deferred = Some(d);
             }
             return;
         }
@@ -883,7 +878,6 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                     self.deferred = Some(Deferred {
                         segment: c,
                         frame: decision.entry_frame,
-                        waited: 0,
                         at: self.pause_ahead(playing, shown).map(|f| (playing, f)),
                     });
                 } else if seamless {

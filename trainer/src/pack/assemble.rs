@@ -359,6 +359,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn segment_energy_is_the_log_of_its_mean_speed_over_the_median_frame() {
+        // All frames sorted: 0 0 1 1 1 1 4 4 4 4, median (nearest rank) 1.
+        let takes = vec![
+            (0, vec![1.0, 1.0, 1.0, 1.0]),
+            (4, vec![4.0, 4.0, 4.0, 4.0]),
+            (8, vec![0.0, 0.0]),
+        ];
+        let e = segment_energies(
+            &takes,
+            &[(0, 0, 4), (1, 1, 3), (2, 0, 2), (0, 2, 2), (5, 0, 1)],
+        );
+        let want = [0.0, 4f32.ln(), 0.01f32.ln(), 0.0, 0.0];
+        for (got, want) in e.iter().zip(want) {
+            assert!((got - want).abs() < 1e-6, "{e:?}");
+        }
+        // A library that never moves: every energy 0.
+        assert_eq!(segment_energies(&[(0, vec![0.0; 3])], &[(0, 0, 3)]), [0.0]);
+    }
+
+    #[test]
     fn calm_frames_are_those_at_or_below_the_30th_percentile_of_all_takes() {
         // Speeds 0..=6 over two takes: the 30th percentile (nearest rank) is 2.
         let takes = [(0, vec![5.0, 1.0, 3.0, 2.0]), (4, vec![4.0, 0.0, 6.0])];
