@@ -3,7 +3,8 @@
 //! tick. Fixed memory (a few bytes and a queue of [`LABEL_QUEUE`]); nothing allocates or
 //! panics.
 
-use super::{Controller, ControllerEvent};
+use super::event::{ControllerEvent, LabelOutcome};
+use super::Controller;
 use crate::player::LibraryFrames;
 use crate::policy::PolicyTables;
 
@@ -40,25 +41,6 @@ impl core::fmt::Display for LabelError {
 }
 
 impl core::error::Error for LabelError {}
-
-/// What became of a label ([`ControllerEvent::Label`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LabelOutcome {
-    /// The label reached the controller (it waits for the next exit point).
-    Received,
-    /// A segment carrying it was entered (at `frame`), or was already playing before its
-    /// stroke.
-    Entered {
-        /// The segment.
-        segment: usize,
-        /// The frame it was entered at.
-        frame: usize,
-    },
-    /// The stroke frame of that segment played: the label is served.
-    Stroke,
-    /// It waited longer than the blob's timeout and was dropped.
-    TimedOut,
-}
 
 /// The label being served.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

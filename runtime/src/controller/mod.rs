@@ -60,7 +60,9 @@
 //! written where they stay, so construction needs only a few KiB of stack beyond the controller
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
+mod event;
 mod labels;
+mod timing;
 
 use crate::blob::Blob;
 use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
@@ -69,58 +71,16 @@ use crate::inference::{
 };
 use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
 use crate::policy::{
-    select_labelled, select_styled, Choice, Decision, History, Penalties, PolicyTables, Style,
-    StyleError, Variety, Visit,
+    select_labelled, select_styled, Choice, History, Penalties, PolicyTables, Style, StyleError,
+    Variety, Visit,
 };
 
+pub use event::{ControllerError, ControllerEvent, LabelOutcome};
 use labels::ActiveLabel;
-pub use labels::{LabelError, LabelOutcome, LABEL_QUEUE, MAX_LABELLED, MAX_LABELS};
+pub use labels::{LabelError, LABEL_QUEUE, MAX_LABELLED, MAX_LABELS};
+pub use timing::DecisionTiming;
 
-use crate::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
-
-/// When the controller decides at exit points (see the module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DecisionTiming {
-    /// Whether decisions wait for syllable onsets; `false` decides at every exit at once.
-    pub sync_to_onsets: bool,
-    /// An onset detected this recently (ms) counts as "now".
-    pub onset_window_ms: u32,
-    /// Longest wait (ms) at a segment's end for an onset (running on meanwhile).
-    pub max_wait_ms: u32,
-    /// Longest hold (ms) at a motion beat waiting for an onset (0: no holds).
-    pub beat_hold_ms: u32,
-    /// How far ahead (ms of frames) a cut decided mid-segment looks for the playing segment's
-    /// calmest next pause of the hands (a calm frame, else a motion beat, else its last frame;
-    /// beyond it, the first that comes; 0: cut at once).
-    pub defer_cut_ms: u32,
-}
-
-impl DecisionTiming {
-    /// Decisions on onsets: an onset within 50 ms, a hold of at most 300 ms at segment ends, a
-    /// cut decided mid-segment put off for at most 400 ms until the hands pause (chosen on
-    /// tuning speech with `gesture-train eval-motion`; see docs/method.md).
-    pub const DEFAULT: Self = Self {
-        sync_to_onsets: true,
-        onset_window_ms: 50,
-        max_wait_ms: 300,
-        beat_hold_ms: 0,
-        defer_cut_ms: 400,
-    };
-    /// Every exit point decides as soon as it is reached.
-    pub const IMMEDIATE: Self = Self {
-        sync_to_onsets: false,
-        onset_window_ms: 0,
-        max_wait_ms: 0,
-        beat_hold_ms: 0,
-        defer_cut_ms: 0,
-    };
-}
-
-impl Default for DecisionTiming {
-    fn default() -> Self {
-        Self::DEFAULT
-    }
-}
+use crate::prosody::{Event, FrontEnd, ProsodyConfig};
 
 /// A cut decided and waiting for the hands to pause.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -132,71 +92,6 @@ struct Deferred {
     /// window (else: the first beat, calm or last frame that comes).
     at: Option<(usize, usize)>,
 }
-
-/// What the controller reports, in time order.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum ControllerEvent<'a> {
-    /// A prosody frame.
-    Frame(Frame),
-    /// A step and the belief after it.
-    Step {
-        /// The step.
-        step: Step,
-        /// Belief over states after the step.
-        belief: &'a [f32],
-    },
-    /// A decision at an exit point.
-    Decision {
-        /// Animation tick of the decision.
-        tick: u64,
-        /// The decision.
-        decision: Decision,
-    },
-    /// The pose of an animation tick (one value per rig channel, degrees).
-    Pose {
-        /// Tick number from 0.
-        tick: u64,
-        /// Channel values.
-        pose: &'a [f32],
-        /// Library segment played (the target of a blend during one).
-        segment: usize,
-        /// Frame of that segment played.
-        frame: usize,
-    },
-    /// A syllable onset was detected (its start frame, 10 ms frames as in [`Frame`]).
-    Onset(u32),
-    /// A semantic label was received, answered by a segment, shown or dropped.
-    Label {
-        /// Animation tick (the tick due next, for `Received`).
-        tick: u64,
-        /// Label index (0-based).
-        label: usize,
-        /// What happened.
-        outcome: LabelOutcome,
-    },
-}
-
-/// Why a controller could not be built.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ControllerError {
-    /// The front-end settings are invalid.
-    FrontEnd(ConfigError),
-    /// The blob's dimensions disagree (GMM clusters vs CRF, states vs policy, channels).
-    Dimensions,
-}
-
-impl core::fmt::Display for ControllerError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Self::FrontEnd(e) => write!(f, "front-end: {e}"),
-            Self::Dimensions => {
-                f.write_str("inconsistent dimensions between inference, policy and library")
-            }
-        }
-    }
-}
-
-impl core::error::Error for ControllerError {}
 
 /// A controller over a blob's tables: what every host tool and board runs.
 pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
