@@ -10,6 +10,8 @@
 //! Dependency-free on purpose, so the runtime's, the trainer's and the simulator's tests can
 //! all use it as a dev-dependency.
 
+pub mod docs;
+
 use std::path::{Path, PathBuf};
 
 /// Set (to anything) to turn every real-data skip into a failure.
