@@ -43,8 +43,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &to.join("speech/lj001-0001-0003.wav"),
     )?;
     let cmu = |clip: &str| from.join(format!("cmu-mocap/{clip}.bvh"));
-    motion(&cmu("18_08"), &to.join("cmu/18_08-listening.bvh"), 0..CUT_18_08)?;
-    motion(&cmu("18_08"), &to.join("cmu/18_08-explaining.bvh"), CUT_18_08..usize::MAX)?;
+    motion(
+        &cmu("18_08"),
+        &to.join("cmu/18_08-listening.bvh"),
+        0..CUT_18_08,
+    )?;
+    motion(
+        &cmu("18_08"),
+        &to.join("cmu/18_08-explaining.bvh"),
+        CUT_18_08..usize::MAX,
+    )?;
     motion(&cmu("19_08"), &to.join("cmu/19_08.bvh"), 0..usize::MAX)?;
     Ok(())
 }

@@ -122,11 +122,15 @@ pub enum Command {
         keywords: PathBuf,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
-    /// utterance, and `run` on it (a few seconds after the build).
+    /// utterance, and `run` on it; then real recorded speech driving a library of real motion
+    /// capture (a few seconds after the build).
     Demo {
         /// Output folder.
         #[arg(long, value_name = "DIR", default_value = "gesture-demo")]
         out: PathBuf,
+        /// Your own recording (WAV) instead of the shipped speech for the real-motion runs.
+        #[arg(long, value_name = "WAV")]
+        audio: Option<PathBuf>,
     },
     /// The motion-quality figures of a `run` output folder (motion.bvh and timeline.json):
     /// variety, freezes, feet, jerk, jumps at cuts, beats.
@@ -266,9 +270,10 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             }
             Ok(())
         }
-        Command::Demo { out: dir } => Ok(crate::demo::demo(
+        Command::Demo { out: dir, audio } => Ok(crate::demo::demo(
             dir,
             crate::demo::DemoParams::default(),
+            audio.as_deref(),
             out,
         )?),
         Command::Live {
