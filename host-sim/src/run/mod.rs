@@ -29,7 +29,9 @@
 //! (simulation only, without rendering and writing).
 
 pub mod blender;
+pub mod body;
 pub mod preview;
+pub mod servos;
 pub mod sim;
 pub mod timeline;
 pub mod video;
@@ -312,17 +314,19 @@ pub fn render(
     ));
     let names: Vec<&str> = blob.channel_names().collect();
     files.push(("servo.csv", servo_csv(sim, &names).into_bytes()));
+    let servo_bars = servos::ServoBars::new(blob);
     files.push((
         "preview.png",
         preview::contact_sheet(sim, skeleton.as_ref()).map_err(render_err("preview.png"))?,
     ));
     files.push((
         "preview.gif",
-        preview::animation(sim, skeleton.as_ref()).map_err(render_err("preview.gif"))?,
+        preview::animation(sim, skeleton.as_ref(), servo_bars.as_ref())
+            .map_err(render_err("preview.gif"))?,
     ));
     let title = format!("gesture-sim run: {} through {}", cx.audio, cx.blob);
     let page = viewer::page(
-        &viewer::data(sim, skeleton.as_ref(), &title),
+        &viewer::data(sim, skeleton.as_ref(), servo_bars.as_ref(), &title),
         samples,
         blob.prosody_config().sample_rate_hz,
     )
@@ -333,7 +337,7 @@ pub fn render(
         if !video::ffmpeg_available() {
             notes.push(video::NO_FFMPEG.to_string());
         } else {
-            match video::render_mp4(sim, skeleton.as_ref(), audio) {
+            match video::render_mp4(sim, skeleton.as_ref(), servo_bars.as_ref(), audio) {
                 Ok(bytes) => files.push(("preview.mp4", bytes)),
                 Err(e) => notes.push(format!("no preview.mp4: {e}")),
             }

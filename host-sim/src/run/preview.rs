@@ -1,8 +1,9 @@
 //! `preview.png` (a contact sheet) and `preview.gif` (an animation) of a run.
 //!
-//! **The contact sheet**, top to bottom: a strip of stick figures at evenly spaced times (the
-//! skeleton's forward kinematics, front view: world X to the right, Y up, one scale for the
-//! strip), each with its time; the intensity curve over the whole audio with the syllables
+//! **The contact sheet**, top to bottom: a strip of the body at evenly spaced times (the
+//! skeleton's forward kinematics drawn as shaded limbs on a floor with their shadow, seen from
+//! the character's front a little above, one scale for the strip: [`super::body`]), each with
+//! its time; the intensity curve over the whole audio with the syllables
 //! shaded and the figure times as grey lines, "enter" decisions as green ticks along the top,
 //! semantic labels as magenta ticks along the bottom joined to a square where their stroke
 //! played;
@@ -10,7 +11,7 @@
 //! colour is `sqrt(p)` on a dark-blue (0) to yellow (1) ramp, so the spread of a belief over
 //! many states still shows); a time axis in seconds.
 //!
-//! **The animation** (320 x 240, 10 frames per second): the stick figure over the same
+//! **The animation** (320 x 240, 10 frames per second): the body over the same
 //! intensity and belief plot with a red cursor, at true speed. At most [`GIF_MAX_FRAMES`]
 //! frames (10 minutes): a longer run is shown as a time-lapse (the frame step grows, the rate
 //! stays 10 fps). `preview.mp4` ([`super::video`]) is the same with sound.
@@ -26,9 +27,11 @@
 
 use std::borrow::Cow;
 
-use gesture_trainer::motion::fk::{all_targets, target_positions, Target};
+use gesture_trainer::motion::fk::{all_targets, target_positions};
 use gesture_trainer::motion::Motion;
 
+use super::body::{BodyModel, Camera, Painter, View, FLOOR, PITCH, SHADOW};
+use super::servos::ServoBars;
 use super::sim::Simulation;
 use gesture_trainer::rig::PoseSkeleton;
 
@@ -40,14 +43,13 @@ pub const GIF_W: usize = 320;
 pub const GIF_H: usize = 240;
 
 pub(super) const BG: u8 = 0;
-const GRID: u8 = 1;
+pub(super) const GRID: u8 = 1;
 const MID: u8 = 2;
 pub(super) const INK: u8 = 3;
 const BLUE: u8 = 4;
 const SYL: u8 = 5;
 pub(super) const RED: u8 = 6;
 const GREEN: u8 = 7;
-const BONE: u8 = 8;
 pub(super) const PANEL: u8 = 9;
 /// Semantic labels: the request and the stroke.
 const LABEL: u8 = 10;
@@ -69,6 +71,7 @@ pub(super) fn palette() -> Vec<u8> {
         [250, 214, 170],
         [215, 30, 30],
         [20, 150, 60],
+        // Unused since the figures became bodies (was the stick figure's ink).
         [45, 45, 70],
         [238, 238, 233],
         [190, 40, 190],
@@ -76,6 +79,8 @@ pub(super) fn palette() -> Vec<u8> {
     for (i, c) in fixed.iter().enumerate() {
         p[3 * i..3 * i + 3].copy_from_slice(c);
     }
+    super::body::palette_into(&mut p);
+    super::servos::palette_into(&mut p);
     // Dark blue -> teal -> green -> yellow (viridis-like stops).
     let stops: [[f64; 3]; 4] = [
         [40.0, 20.0, 80.0],
@@ -183,26 +188,6 @@ impl Canvas {
         }
     }
 
-    pub(super) fn thick_line(&mut self, a: (i64, i64), b: (i64, i64), c: u8) {
-        for (ox, oy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-            self.line((a.0 + ox, a.1 + oy), (b.0 + ox, b.1 + oy), c);
-        }
-    }
-
-    fn circle(&mut self, cx: i64, cy: i64, r: i64, c: u8) {
-        let steps = (8 * r).max(16);
-        let mut prev = (cx + r, cy);
-        for k in 1..=steps {
-            let t = k as f64 / steps as f64 * std::f64::consts::TAU;
-            let p = (
-                cx + (r as f64 * t.cos()).round() as i64,
-                cy + (r as f64 * t.sin()).round() as i64,
-            );
-            self.thick_line(prev, p, c);
-            prev = p;
-        }
-    }
-
     /// Digits at 2x scale, top-left at (x, y); returns the width drawn.
     pub(super) fn text(&mut self, x: i64, y: i64, s: &str, c: u8) -> i64 {
         let mut cx = x;
@@ -223,19 +208,24 @@ impl Canvas {
     }
 }
 
-/// Stick-figure geometry: 2-D points per frame and the bones between them.
+/// A body over time, seen by one camera ([`super::body`]): the points of every frame in the
+/// camera's frame (right, up, toward it) and one scale for the whole run.
 pub(super) struct Figure {
-    /// Per frame, per point (joints then end sites): world (x, y).
-    frames: Vec<Vec<(f64, f64)>>,
-    bones: Vec<(usize, usize)>,
-    head: Option<usize>,
-    /// World bounding box (x0, y0, x1, y1) over all frames.
+    /// Per frame, per point (joints then end sites).
+    frames: Vec<Vec<[f64; 3]>>,
+    body: BodyModel,
+    /// The floor disk's centre (camera frame).
+    floor_centre: [f64; 3],
+    /// Bounding box (right, up) over all frames with the limbs' thickness, the floor disk
+    /// and the shadow: (x0, y0, x1, y1).
     bbox: (f64, f64, f64, f64),
 }
 
+/// The floor disk's radius (body heights).
+const FLOOR_RADIUS: f64 = 0.42;
+
 impl Figure {
-    /// The figure of `poses` seen from the front (world X right, Y up) or, with `side`, from
-    /// the character's left (world Z right, Y up).
+    /// The figure of `poses` seen from the character's front or, with `side`, from its left.
     pub(super) fn new(
         sk: &PoseSkeleton,
         poses: &[&Vec<f32>],
@@ -250,93 +240,106 @@ impl Figure {
         let skeleton = sk.skeleton();
         let targets = all_targets(skeleton, true);
         let pos = target_positions(&motion, &targets).ok()?;
-        let index = |t: Target| targets.iter().position(|&x| x == t);
-        let mut bones = Vec::new();
-        for (j, joint) in skeleton.joints.iter().enumerate() {
-            if let Some(p) = joint.parent {
-                if let (Some(a), Some(b)) = (index(Target::Joint(p)), index(Target::Joint(j))) {
-                    bones.push((a, b));
-                }
-            }
-            if let (Some(a), Some(b)) = (index(Target::Joint(j)), index(Target::EndSite(j))) {
-                bones.push((a, b));
-            }
-        }
-        let head = skeleton
-            .joints
+        let world: Vec<&[[f64; 3]]> = (0..pos.frames()).map(|f| pos.frame(f)).collect();
+        let body = BodyModel::new(skeleton, &targets, &world)?;
+        let view = View::new(&body, if side { Camera::Left } else { Camera::Front });
+        let frames: Vec<Vec<[f64; 3]>> = world
             .iter()
-            .position(|j| j.name.eq_ignore_ascii_case("head"))
-            .or_else(|| {
-                skeleton
-                    .joints
-                    .iter()
-                    .position(|j| j.name.to_ascii_lowercase().contains("head"))
-            })
-            .and_then(|j| index(Target::EndSite(j)).or(index(Target::Joint(j))));
-        let frames: Vec<Vec<(f64, f64)>> = (0..pos.frames())
-            .map(|f| {
-                pos.frame(f)
-                    .iter()
-                    .map(|p| (if side { p[2] } else { p[0] }, p[1]))
-                    .collect()
-            })
+            .map(|f| f.iter().map(|&p| view.project(p)).collect())
             .collect();
-        let mut bbox = (
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
+        let root = world[0].first().copied().unwrap_or([0.0; 3]);
+        let floor_centre = view.project([root[0], body.floor, root[2]]);
+        let (fr, fy) = (
+            FLOOR_RADIUS * body.height,
+            FLOOR_RADIUS * body.height * PITCH.sin(),
         );
+        let mut bbox = (
+            floor_centre[0] - fr,
+            floor_centre[1] - fy,
+            floor_centre[0] + fr,
+            floor_centre[1] + fy,
+        );
+        let pad = 0.07 * body.height;
         for p in frames.iter().flatten() {
-            if p.0.is_finite() && p.1.is_finite() {
+            if p[0].is_finite() && p[1].is_finite() {
                 bbox = (
-                    bbox.0.min(p.0),
-                    bbox.1.min(p.1),
-                    bbox.2.max(p.0),
-                    bbox.3.max(p.1),
+                    bbox.0.min(p[0] - pad),
+                    bbox.1.min(p[1] - pad),
+                    bbox.2.max(p[0] + pad),
+                    bbox.3.max(p[1] + pad),
                 );
             }
         }
-        if !(bbox.0.is_finite() && bbox.2 > bbox.0 - 1e-9) {
+        if !(bbox.0.is_finite() && bbox.1.is_finite() && bbox.2 > bbox.0 && bbox.3 > bbox.1) {
             return None;
         }
         Some(Self {
             frames,
-            bones,
-            head,
+            body,
+            floor_centre,
             bbox,
         })
     }
 
-    /// Draws frame `f` into the box (x, y, w, h).
+    /// Draws frame `f` into the box (x, y, w, h): the floor disk, the shadow, the body.
     pub(super) fn draw(&self, cv: &mut Canvas, f: usize, (x, y, w, h): (i64, i64, i64, i64)) {
         let Some(pts) = self.frames.get(f) else {
             return;
         };
-        let (bw, bh) = (
-            (self.bbox.2 - self.bbox.0).max(1e-6),
-            (self.bbox.3 - self.bbox.1).max(1e-6),
-        );
-        let scale = 0.9 * (w as f64 / bw).min(h as f64 / bh);
+        let (bw, bh) = (self.bbox.2 - self.bbox.0, self.bbox.3 - self.bbox.1);
+        let scale = 0.94 * (w as f64 / bw).min(h as f64 / bh);
         let (cx, cy) = (
             0.5 * (self.bbox.0 + self.bbox.2),
             0.5 * (self.bbox.1 + self.bbox.3),
         );
-        let map = |p: (f64, f64)| -> Option<(i64, i64)> {
-            let sx = x as f64 + w as f64 / 2.0 + (p.0 - cx) * scale;
-            let sy = y as f64 + h as f64 / 2.0 - (p.1 - cy) * scale;
-            (sx.is_finite() && sy.is_finite()).then_some((sx.round() as i64, sy.round() as i64))
+        let map = |p: [f64; 3]| -> [f64; 3] {
+            [
+                x as f64 + w as f64 / 2.0 + (p[0] - cx) * scale,
+                y as f64 + h as f64 / 2.0 - (p[1] - cy) * scale,
+                p[2] * scale,
+            ]
         };
-        for &(a, b) in &self.bones {
-            if let (Some(pa), Some(pb)) = (
-                pts.get(a).and_then(|&p| map(p)),
-                pts.get(b).and_then(|&p| map(p)),
-            ) {
-                cv.thick_line(pa, pb, BONE);
+        let finite = |p: &[f64; 3]| p.iter().all(|c| c.is_finite());
+        let mut painter = Painter::new(cv, (x, y, w, h));
+        let fc = map(self.floor_centre);
+        let fr = FLOOR_RADIUS * self.body.height * scale;
+        painter.ellipse((fc[0], fc[1]), fr, fr * PITCH.sin(), FLOOR);
+        // The shadow: every limb dropped straight down onto the floor (light from above).
+        let (s, c) = PITCH.sin_cos();
+        let on_floor = |p: [f64; 3]| {
+            // Back to the distance toward the camera, at the floor's height, projected again.
+            let toward = p[2] * c - p[1] * s;
+            let fy = self.body.floor;
+            map([p[0], fy * c - toward * s, toward * c + fy * s])
+        };
+        for l in &self.body.limbs {
+            if let (Some(a), Some(b)) = (pts.get(l.a), pts.get(l.b)) {
+                if finite(a) && finite(b) {
+                    let (a, b) = (on_floor(*a), on_floor(*b));
+                    painter.flat_capsule(
+                        (a[0], a[1]),
+                        (b[0], b[1]),
+                        0.8 * l.radius * scale,
+                        SHADOW,
+                    );
+                }
             }
         }
-        if let Some(p) = self.head.and_then(|k| pts.get(k)).and_then(|&p| map(p)) {
-            cv.circle(p.0, p.1, (h / 22).clamp(3, 9), BONE);
+        for l in &self.body.limbs {
+            if let (Some(a), Some(b)) = (pts.get(l.a), pts.get(l.b)) {
+                if finite(a) && finite(b) {
+                    painter.capsule(map(*a), map(*b), l.radius * scale);
+                }
+            }
+        }
+        for ball in &self.body.balls {
+            if let (Some(a), Some(b)) = (pts.get(ball.a), pts.get(ball.b)) {
+                let p = [0, 1, 2].map(|k| a[k] + ball.t * (b[k] - a[k]));
+                if finite(&p) {
+                    let m = map(p);
+                    painter.capsule(m, m, ball.radius * scale);
+                }
+            }
         }
     }
 }
@@ -541,8 +544,12 @@ pub fn contact_sheet(sim: &Simulation, sk: Option<&PoseSkeleton>) -> Result<Vec<
     Ok(out)
 }
 
-/// The animation as GIF bytes.
-pub fn animation(sim: &Simulation, sk: Option<&PoseSkeleton>) -> Result<Vec<u8>, String> {
+/// The animation as GIF bytes (with a rig's servo bars at the right of the figure).
+pub fn animation(
+    sim: &Simulation,
+    sk: Option<&PoseSkeleton>,
+    servos: Option<&ServoBars>,
+) -> Result<Vec<u8>, String> {
     let (w, h) = (GIF_W as i64, GIF_H as i64);
     let dur = sim.duration_s.max(0.1);
     let step = (dur / GIF_MAX_FRAMES as f64).max(0.1);
@@ -575,8 +582,12 @@ pub fn animation(sim: &Simulation, sk: Option<&PoseSkeleton>) -> Result<Vec<u8>,
         for (k, &t) in times.iter().enumerate() {
             let mut cv = base.clone();
             cv.fill(0, 0, w, fig_h, PANEL);
+            let fig_w = if servos.is_some() { w * 3 / 4 } else { w };
             if let Some(fig) = &fig {
-                fig.draw(&mut cv, k, (0, 2, w, fig_h - 4));
+                fig.draw(&mut cv, k, (0, 2, fig_w, fig_h - 4));
+            }
+            if let (Some(s), Some(d)) = (servos, sim.duties.get(ticks[k])) {
+                s.draw(&mut cv, d, (fig_w, 12, w - fig_w - 6, fig_h - 24));
             }
             cv.text(4, 4, &format!("{t:.1}s"), INK);
             let x = px + ((t / dur) * (pw - 1) as f64).round() as i64;

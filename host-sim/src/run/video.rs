@@ -1,8 +1,9 @@
 //! `preview.mp4`: the run as a video with the speech as its sound track, at real-time length.
 //!
-//! Each frame (640 x 360, 30 frames per second of audio): the character seen from the front
-//! and from its left side (the skeleton's forward kinematics, one scale per view for the whole
-//! run), the time in seconds, and the run's timeline under it (the intensity with the syllables
+//! Each frame (640 x 360, 30 frames per second of audio): the character's body seen from the
+//! front and from its left side (the skeleton's forward kinematics drawn by [`super::body`],
+//! one scale per view for the whole run), a rig's servo channels as bars
+//! ([`super::servos`]), the time in seconds, and the run's timeline under it (the intensity with the syllables
 //! shaded and the "enter" decisions as green ticks, the belief as a heat strip, a red cursor at
 //! the frame's time), drawn with the same canvas as `preview.png` and `preview.gif`.
 //!
@@ -20,6 +21,7 @@ use std::process::{Command, Stdio};
 use gesture_trainer::rig::PoseSkeleton;
 
 use super::preview::{palette, Canvas, Figure, Plot, BG, INK, PANEL, RED};
+use super::servos::ServoBars;
 use super::sim::Simulation;
 
 /// Video size.
@@ -48,6 +50,7 @@ pub const NO_FFMPEG: &str = "no preview.mp4: the `ffmpeg` program is not on PATH
 fn frames(
     sim: &Simulation,
     sk: Option<&PoseSkeleton>,
+    servos: Option<&ServoBars>,
     mut each: impl FnMut(&Canvas) -> Result<(), String>,
 ) -> Result<(), String> {
     let (w, h) = (VIDEO_W as i64, VIDEO_H as i64);
@@ -73,12 +76,22 @@ fn frames(
         let t = k as f64 / VIDEO_FPS;
         let mut cv = base.clone();
         cv.fill(0, 0, w, fig_h, PANEL);
-        cv.line((w / 2, 8), (w / 2, fig_h - 8), BG);
+        // Two views, and a rig's servo bars in the last sixth.
+        let view_w = if servos.is_some() { w * 5 / 12 } else { w / 2 };
+        cv.line((view_w, 8), (view_w, fig_h - 8), BG);
         if let Some(f) = &front {
-            f.draw(&mut cv, k, (0, 4, w / 2, fig_h - 8));
+            f.draw(&mut cv, k, (0, 4, view_w, fig_h - 8));
         }
         if let Some(f) = &side {
-            f.draw(&mut cv, k, (w / 2, 4, w / 2, fig_h - 8));
+            f.draw(&mut cv, k, (view_w, 4, view_w, fig_h - 8));
+        }
+        if let (Some(s), Some(d)) = (servos, sim.duties.get(ticks[k])) {
+            cv.line((2 * view_w, 8), (2 * view_w, fig_h - 8), BG);
+            s.draw(
+                &mut cv,
+                d,
+                (2 * view_w + 6, 24, w - 2 * view_w - 12, fig_h - 48),
+            );
         }
         cv.text(6, 6, &format!("{t:.1}s"), INK);
         let x = px + ((t / dur) * (pw - 1) as f64).round() as i64;
@@ -93,6 +106,7 @@ fn frames(
 pub fn render_mp4(
     sim: &Simulation,
     sk: Option<&PoseSkeleton>,
+    servos: Option<&ServoBars>,
     audio: &Path,
 ) -> Result<Vec<u8>, String> {
     let tmp = tempfile::Builder::new()
@@ -126,7 +140,7 @@ pub fn render_mp4(
     let mut rgb = vec![0u8; VIDEO_W * VIDEO_H * 3];
     let written = {
         let mut stdin = child.stdin.take().ok_or("ffmpeg has no input pipe")?;
-        frames(sim, sk, |cv| {
+        frames(sim, sk, servos, |cv| {
             for (o, &i) in rgb.chunks_exact_mut(3).zip(&cv.px) {
                 o.copy_from_slice(&pal[3 * i as usize..3 * i as usize + 3]);
             }
@@ -158,7 +172,7 @@ mod tests {
             ..Simulation::default()
         };
         let mut n = 0;
-        frames(&sim, None, |cv| {
+        frames(&sim, None, None, |cv| {
             assert_eq!((cv.w, cv.h), (VIDEO_W, VIDEO_H));
             n += 1;
             Ok(())

@@ -5,18 +5,24 @@
 //! controller heard, at the blob's rate), the skeleton's joint positions per frame (forward
 //! kinematics of the played poses, at most [`VIEWER_FPS`] frames per second, millimetre
 //! precision), its bones, and the timeline (intensity, syllables, decisions, the belief after
-//! each step). A small script draws the skeleton for the audio's current time on a canvas
-//! (orthographic; drag to orbit, wheel to zoom, double-click to reset), and the timeline under
-//! it with a cursor (click or drag to scrub; space plays and pauses). Written as text with
+//! each step). A small script draws the skeleton for the audio's current time on a canvas as a
+//! body ([`super::body`]'s model: limbs as shaded capsules sorted back to front, a shaded
+//! head, the floor disk and the limbs' shadow on it; orthographic, first seen from the
+//! character's front a little above; drag to orbit, wheel to zoom, double-click to reset),
+//! a rig's servo channels as moving bars beside it ([`super::servos`]: the pulse each is sent
+//! between its limits), and the timeline under it with a cursor (click or drag to scrub;
+//! space plays and pauses). Written as text with
 //! `serde_json` and `base64`; no template engine (the page is one string with one data slot).
 
 use base64::Engine;
 use serde::Serialize;
 
 use gesture_runtime::prosody::StepKind;
-use gesture_trainer::motion::fk::{all_targets, target_positions, Target};
+use gesture_trainer::motion::fk::{all_targets, target_positions};
 use gesture_trainer::rig::PoseSkeleton;
 
+use super::body::BodyModel;
+use super::servos::ServoBars;
 use super::sim::Simulation;
 
 /// Most skeleton frames per second in the page.
@@ -35,10 +41,18 @@ pub struct ViewerData {
     pub points: usize,
     /// Per frame, `points * 3` coordinates (x, y, z; skeleton units, Y up), rounded to 0.1.
     pub frames: Vec<Vec<f32>>,
-    /// Bones as point index pairs.
-    pub bones: Vec<[usize; 2]>,
-    /// The head's point, for a circle.
-    pub head: Option<usize>,
+    /// Limbs: point indices and radius (skeleton units).
+    pub limbs: Vec<(usize, usize, f32)>,
+    /// Balls (the head first, the hands) at `a + t (b - a)`: a, b, t, radius.
+    pub balls: Vec<(usize, usize, f32, f32)>,
+    /// Floor height (Y).
+    pub floor: f32,
+    /// Body height (skeleton units).
+    pub height: f32,
+    /// The camera's first yaw (rad): looking at the character's front.
+    pub yaw: f32,
+    /// A rig's servo channels and their pulses (us) per frame.
+    pub servos: Option<ServoView>,
     /// Intensity (dB) every 20 ms from 0 s.
     pub intensity: Vec<f32>,
     /// Syllables: start and end (s).
@@ -49,16 +63,37 @@ pub struct ViewerData {
     pub beliefs: Vec<(f64, Vec<f32>)>,
 }
 
-/// The page's data from a run (`sk`: the blob's skeleton; without one, no figure).
-pub fn data(sim: &Simulation, sk: Option<&PoseSkeleton>, title: &str) -> ViewerData {
+/// A rig's servo bars in the page.
+#[derive(Debug, Serialize)]
+pub struct ServoView {
+    /// Names and limits.
+    #[serde(flatten)]
+    pub bars: ServoBars,
+    /// Per skeleton frame (or per [`VIEWER_FPS`] frame without a skeleton), each channel's
+    /// pulse (us, rounded).
+    pub pulses: Vec<Vec<f32>>,
+}
+
+/// The page's data from a run (`sk`: the blob's skeleton; without one, no figure; `servos`:
+/// the rig's bars, if it has servos).
+pub fn data(
+    sim: &Simulation,
+    sk: Option<&PoseSkeleton>,
+    servos: Option<&ServoBars>,
+    title: &str,
+) -> ViewerData {
     let mut d = ViewerData {
         title: title.to_string(),
         duration_s: sim.duration_s,
         fps: VIEWER_FPS.min(sim.fps.max(1.0)),
         points: 0,
         frames: Vec::new(),
-        bones: Vec::new(),
-        head: None,
+        limbs: Vec::new(),
+        balls: Vec::new(),
+        floor: 0.0,
+        height: 1.0,
+        yaw: 0.0,
+        servos: None,
         intensity: Vec::new(),
         syllables: Vec::new(),
         decisions: sim
@@ -90,16 +125,25 @@ pub fn data(sim: &Simulation, sk: Option<&PoseSkeleton>, title: &str) -> ViewerD
         d.intensity
             .push(if v.is_finite() { v.max(-300.0) } else { -300.0 });
     }
+    let n = (sim.duration_s * d.fps).ceil() as usize;
+    let last = sim.poses.len().saturating_sub(1);
+    let ticks: Vec<usize> = (0..n)
+        .map(|k| ((k as f64 / d.fps * sim.fps).round() as usize).min(last))
+        .collect();
+    d.servos = servos.map(|b| ServoView {
+        bars: b.clone(),
+        pulses: ticks
+            .iter()
+            .filter_map(|&t| sim.duties.get(t))
+            .map(|row| row.iter().map(|&x| b.pulse_us(x).round()).collect())
+            .collect(),
+    });
     let Some(sk) = sk else {
         return d;
     };
-    let n = (sim.duration_s * d.fps).ceil() as usize;
-    let last = sim.poses.len().saturating_sub(1);
-    let poses: Vec<Vec<f32>> = (0..n)
-        .filter_map(|k| {
-            let tick = ((k as f64 / d.fps * sim.fps).round() as usize).min(last);
-            sim.poses.get(tick).cloned()
-        })
+    let poses: Vec<Vec<f32>> = ticks
+        .iter()
+        .filter_map(|&tick| sim.poses.get(tick).cloned())
         .collect();
     let Ok(motion) = sk.motion(&poses, d.fps) else {
         return d;
@@ -109,22 +153,22 @@ pub fn data(sim: &Simulation, sk: Option<&PoseSkeleton>, title: &str) -> ViewerD
     let Ok(pos) = target_positions(&motion, &targets) else {
         return d;
     };
-    let index = |t: Target| targets.iter().position(|&x| x == t);
-    for (j, joint) in skeleton.joints.iter().enumerate() {
-        if let Some(p) = joint.parent {
-            if let (Some(a), Some(b)) = (index(Target::Joint(p)), index(Target::Joint(j))) {
-                d.bones.push([a, b]);
-            }
-        }
-        if let (Some(a), Some(b)) = (index(Target::Joint(j)), index(Target::EndSite(j))) {
-            d.bones.push([a, b]);
-        }
+    let world: Vec<&[[f64; 3]]> = (0..pos.frames()).map(|f| pos.frame(f)).collect();
+    if let Some(body) = BodyModel::new(skeleton, &targets, &world) {
+        d.limbs = body
+            .limbs
+            .iter()
+            .map(|l| (l.a, l.b, l.radius as f32))
+            .collect();
+        d.balls = body
+            .balls
+            .iter()
+            .map(|b| (b.a, b.b, b.t as f32, b.radius as f32))
+            .collect();
+        d.floor = body.floor as f32;
+        d.height = body.height as f32;
+        d.yaw = body.left[2].atan2(body.left[0]) as f32;
     }
-    d.head = skeleton
-        .joints
-        .iter()
-        .position(|j| j.name.to_ascii_lowercase().contains("head"))
-        .and_then(|j| index(Target::EndSite(j)).or(index(Target::Joint(j))));
     d.points = targets.len();
     d.frames = (0..pos.frames())
         .map(|f| {
@@ -198,7 +242,7 @@ mod tests {
             fps: 30.0,
             ..Simulation::default()
         };
-        let d = data(&sim, None, "</script><b>");
+        let d = data(&sim, None, None, "</script><b>");
         let html = page(&d, &[0; 160], 16000).unwrap();
         assert_eq!(html.matches("</script>").count(), 1);
         assert!(html.contains("&lt;/script&gt;&lt;b&gt;"));
