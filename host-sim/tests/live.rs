@@ -164,30 +164,6 @@ fn without_an_audio_device_live_and_devices_fail_in_one_line() {
     }
 }
 
-// ----- demo ---------------------------------------------------------------------------------
-
-#[test]
-fn demo_runs_end_to_end_into_a_temp_dir() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("demo");
-    let t = std::time::Instant::now();
-    let o = sim(&["demo", "--out", out.to_str().unwrap()]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(t.elapsed().as_secs() < 180, "{:?}", t.elapsed());
-    let stdout = text(&o.stdout);
-    assert!(stdout.contains("done in"), "{stdout}");
-    for f in [
-        "model.json",
-        "puppet-8ch.toml",
-        "utterance.wav",
-        "corpus/truth.json",
-    ] {
-        assert!(out.join(f).is_file(), "{f} missing");
-    }
-    check_outputs(&out.join("character.blob"), &out.join("run-character"));
-    check_outputs(&out.join("puppet.blob"), &out.join("run-puppet"));
-}
-
 /// With keyword spotting (feature `kws`) and the shared recordings: BEAT's second monologue
 /// through a fake microphone at 44.1 kHz; "fashion" brings the label `wave`.
 #[cfg(feature = "kws")]

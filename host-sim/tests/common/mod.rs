@@ -124,7 +124,7 @@ pub const OUTPUTS: [&str; 6] = [
 
 /// `viewer.html` holds the speech (a WAV as long as the run) and a skeleton frame per 1/30 s
 /// whose bones index its points; one script, no network.
-pub fn check_viewer(dir: &Path, seconds: f64) {
+pub fn check_viewer(dir: &Path, seconds: f64, servos: usize) {
     use base64::Engine;
     let html = std::fs::read_to_string(dir.join("viewer.html")).unwrap();
     assert_eq!(html.matches("<script").count(), 1);
@@ -143,8 +143,29 @@ pub fn check_viewer(dir: &Path, seconds: f64) {
     assert!(frames
         .iter()
         .all(|f| f.as_array().unwrap().len() == 3 * points));
-    for b in v["bones"].as_array().unwrap() {
+    // The body: limbs with thickness, the head and the hands as balls, a floor.
+    let limbs = v["limbs"].as_array().unwrap();
+    assert!(limbs.len() >= 10, "{} limbs", limbs.len());
+    for l in limbs {
+        assert!(l[0].as_u64().unwrap() < points as u64 && l[1].as_u64().unwrap() < points as u64);
+        assert!(l[2].as_f64().unwrap() > 0.0);
+    }
+    let balls = v["balls"].as_array().unwrap();
+    assert_eq!(balls.len(), 3, "the head and two hands: {balls:?}");
+    let height = v["height"].as_f64().unwrap();
+    for b in balls {
         assert!(b[0].as_u64().unwrap() < points as u64 && b[1].as_u64().unwrap() < points as u64);
+        assert!(b[3].as_f64().unwrap() > 0.0 && b[3].as_f64().unwrap() < 0.1 * height);
+    }
+    assert!(v["floor"].as_f64().unwrap().is_finite());
+    // A rig's servos: one pulse per channel per frame.
+    if servos == 0 {
+        assert!(v["servos"].is_null());
+    } else {
+        let pulses = v["servos"]["pulses"].as_array().unwrap();
+        assert_eq!(pulses.len(), frames.len());
+        assert!(pulses.iter().all(|p| p.as_array().unwrap().len() == servos));
+        assert_eq!(v["servos"]["names"].as_array().unwrap().len(), servos);
     }
     let b64 = html.split("data:audio/wav;base64,").nth(1).unwrap();
     let b64 = &b64[..b64.find('"').unwrap()];
@@ -175,7 +196,12 @@ pub fn check_outputs(blob_path: &Path, dir: &Path) {
     assert!(ticks > 100, "{ticks}");
     let motion = read_bvh(dir.join("motion.bvh")).unwrap();
     assert_eq!(motion.frames(), ticks);
-    check_viewer(dir, tl["duration_s"].as_f64().unwrap());
+    let servos = if blob.rig_name() == "full-skeleton" {
+        0
+    } else {
+        blob.channels()
+    };
+    check_viewer(dir, tl["duration_s"].as_f64().unwrap(), servos);
     assert!((motion.fps() - blob.fps() as f64).abs() < 1e-3);
     let sk = blob.skeleton().unwrap();
     assert_eq!(motion.skeleton().joints.len(), sk.joints());
