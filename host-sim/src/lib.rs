@@ -20,7 +20,8 @@
 //! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
 //!   [`live::AudioSource`] trait, with a fake source for tests.
 //! - [`error`]: [`error::SimError`], the error of every command, and its exit status.
-//! - [`demo`]: `gesture-sim demo`: synth, fit, pack, a new utterance and `run`, in one command.
+//! - [`demo`]: `gesture-sim demo`: synth, fit, pack, a new utterance and `run`, in one command,
+//!   then the model driving the shipped real motion capture with real recorded speech.
 //! - [`servo`]: virtual PWM pins under the runtime's `ServoRig`.
 //! - [`soak`]: `gesture-sim soak`: hours of hostile audio through a blob's device loop (drift,
 //!   limits, memory).
