@@ -1,6 +1,6 @@
 //! The skeleton drawn as a body: limbs as shaded capsules with thickness by what they are, a
 //! head, a floor and the body's shadow on it. One model for every picture of a run: the
-//! previews draw it here ([`Painter`], palette-index pixels with a depth buffer) and
+//! previews draw it here (`Painter`: palette-index pixels with a depth buffer) and
 //! `viewer.html` draws the same shapes on a canvas from [`BodyModel`]'s numbers.
 //!
 //! **Thickness by name.** A bone belongs to the joint it leaves (the upper arm is the bone
@@ -396,7 +396,8 @@ impl<'a> Painter<'a> {
                 let nz = (1.0 - (d / r) * (d / r)).max(0.0).sqrt();
                 let z = (a[2] + t * (b[2] - a[2]) + nz * r) as f32;
                 let k = ((py - self.y) * self.w + (px - self.x)) as usize;
-                if !(z > self.depth[k]) {
+                // Nearest wins (a NaN depth never does).
+                if z.partial_cmp(&self.depth[k]) != Some(std::cmp::Ordering::Greater) {
                     continue;
                 }
                 self.depth[k] = z;

@@ -72,7 +72,7 @@ fn frames(
     let plot = Plot::new(sim);
     plot.intensity(&mut base, (px, y_plot, pw, plot_h), &[]);
     plot.belief(&mut base, (px, y_belief, pw, belief_h));
-    for k in 0..n {
+    for (k, &tick) in ticks.iter().enumerate() {
         let t = k as f64 / VIDEO_FPS;
         let mut cv = base.clone();
         cv.fill(0, 0, w, fig_h, PANEL);
@@ -85,7 +85,7 @@ fn frames(
         if let Some(f) = &side {
             f.draw(&mut cv, k, (view_w, 4, view_w, fig_h - 8));
         }
-        if let (Some(s), Some(d)) = (servos, sim.duties.get(ticks[k])) {
+        if let (Some(s), Some(d)) = (servos, sim.duties.get(tick)) {
             cv.line((2 * view_w, 8), (2 * view_w, fig_h - 8), BG);
             s.draw(
                 &mut cv,
