@@ -135,10 +135,13 @@ mod tests {
         let duty = (1750.0 / 20_000.0 * MAX_DUTY as f32).round() as u16;
         b.draw(&mut cv, &[duty, 0], (0, 0, 20, 11));
         let column: Vec<u8> = (0..11).map(|y| cv.px[y * 20 + 4]).collect();
-        assert_eq!(
-            column.iter().filter(|&&c| c == BAR).count(),
-            8,
+        // Rows 0..=10; 0.75 of the travel is row 3 (the duty's rounding keeps it just under);
+        // the neutral tick (row 5) is drawn over the fill.
+        assert_eq!(column[..3], [GRID; 3], "{column:?}");
+        assert!(
+            column[3..].iter().all(|&c| c == BAR || c == INK),
             "{column:?}"
         );
+        assert_eq!(column[5], INK, "{column:?}");
     }
 }
