@@ -1,6 +1,6 @@
 //! Puts `memory.x` on the linker's path and the policy blob into `OUT_DIR/policy.blob`.
 //!
-//! The blob is `$GESTURE_BLOB` if set, else the QEMU firmware's (`../qemu-m4/assets/policy.blob`,
+//! The blob is `$GESTURE_BLOB` if set, else the QEMU firmware's (`../qemu/assets/policy.blob`,
 //! made by `boards/qemu-m4/make-assets`), so a fresh checkout builds after one script.
 
 use std::path::PathBuf;
@@ -15,7 +15,7 @@ fn main() {
     println!("cargo:rerun-if-env-changed=GESTURE_BLOB");
     let blob = env::var_os("GESTURE_BLOB")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("../qemu-m4/assets/policy.blob"));
+        .unwrap_or_else(|| PathBuf::from("../qemu/assets/policy.blob"));
     println!("cargo:rerun-if-changed={}", blob.display());
     match fs::read(&blob) {
         Ok(bytes) => fs::write(out.join("policy.blob"), bytes).expect("writing the blob"),

@@ -1,4 +1,5 @@
-//! The host side of the QEMU Cortex-M4F check (`boards/qemu-m4`).
+//! The host side of the QEMU firmware's check (`boards/qemu`, run as `boards/qemu-m4` and
+//! `boards/qemu-m33`).
 //!
 //! - `audio --wav TAKE.wav --seconds S --out DIR` writes the firmware's two inputs as raw
 //!   little-endian i16 at 16 kHz: `DIR/speech.raw` (the first `S` seconds of the take) and
@@ -7,7 +8,7 @@
 //!   full-scale 200 Hz square wave from `i16::MIN` to `i16::MAX`).
 //!   Each also as a 16 kHz mono 16-bit WAV (`speech.wav`, `stress.wav`) for `gesture-sim run`.
 //! - `trace --blob BLOB --input NAME=FILE ...` prints the reference decision trace: the
-//!   firmware's own drive loop (`boards/qemu-m4/src/drive.rs`, included below) over the same
+//!   firmware's own drive loop (`boards/qemu/src/drive.rs`, included below) over the same
 //!   samples in the same 256-sample chunks, so its output must equal the firmware's stdout
 //!   byte for byte.
 //! - `sim-decisions --timeline timeline.json` prints the decisions of a `gesture-sim run`
@@ -16,7 +17,7 @@
 //!
 //! Exit status: 0 on success, 1 on any error (one line on stderr naming the file).
 
-#[path = "../../boards/qemu-m4/src/drive.rs"]
+#[path = "../../boards/qemu/src/drive.rs"]
 mod drive;
 
 use std::path::{Path, PathBuf};
@@ -27,7 +28,7 @@ use clap::{Parser, Subcommand};
 #[derive(Debug, Parser)]
 #[command(
     name = "qemu_m4_host",
-    about = "Inputs and reference trace for boards/qemu-m4"
+    about = "Inputs and reference trace for boards/qemu (qemu-m4, qemu-m33)"
 )]
 struct Cli {
     #[command(subcommand)]

@@ -1,5 +1,6 @@
-//! Firmware for QEMU's `mps2-an386` (Cortex-M4F): the gesture-controller runtime on the
-//! device, fed from flash as a microphone DMA would feed it.
+//! Firmware for QEMU's `mps2-an386` (Cortex-M4F) and `mps2-an505` (Cortex-M33F): the
+//! gesture-controller runtime on the device, fed from flash as a microphone DMA would feed it.
+//! The target selects the board (`build.rs`: its memory map); the code is the same for both.
 //!
 //! It embeds a policy blob and two 16 kHz inputs made by `make-assets` (`assets/`, not in
 //! git): `speech` (a held-out synthetic take) and `stress` (silence, clipped speech, white

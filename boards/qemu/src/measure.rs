@@ -4,10 +4,11 @@
 //!
 //! Under `qemu-system-arm -icount shift=0` every guest instruction advances virtual time by
 //! exactly 1 ns, and the Cortex-M's DWT cycle counter reads 0. SysTick, free-running from the
-//! core clock (25 MHz on `mps2-an386`), therefore ticks once per 40 instructions, repeatably.
+//! core clock (25 MHz on `mps2-an386`, 20 MHz on `mps2-an505`), therefore ticks once per 40 (50)
+//! instructions, repeatably.
 //! [`Clock`] extends its 24-bit down-counter to 64 bits (it is read far more often than it
 //! wraps, every 16.7 M ticks) and [`calibrate`] measures the instructions per tick on a loop of
-//! known length, so nothing here assumes the 40. Resolution is one tick (40 instructions).
+//! known length, so nothing here assumes the 40. Resolution is one tick (40 or 50 instructions).
 //!
 //! ## What is timed
 //!
