@@ -65,6 +65,7 @@ pub enum Command {
     },
     /// Run a policy blob on a WAV file and write motion.bvh, timeline.json, servo.csv and
     /// previews into a folder.
+    #[command(group(clap::ArgGroup::new("ros_output").multiple(true).args(["ros2", "mcap"])))]
     Run {
         /// Policy blob (from `gesture-train pack`).
         #[arg(long, value_name = "BLOB")]
@@ -99,6 +100,18 @@ pub enum Command {
         /// motion and its speech as one scene.
         #[arg(long)]
         blender: bool,
+        /// Publish the joint states to ROS 2 as sensor_msgs/JointState over DDS (feature
+        /// `ros2`; domain from ROS_DOMAIN_ID); with --realtime at their times. Also writes
+        /// robot.urdf.
+        #[arg(long)]
+        ros2: bool,
+        /// The topic of --ros2 and --mcap [default: /joint_states].
+        #[arg(long, value_name = "TOPIC", requires = "ros_output")]
+        ros2_topic: Option<String>,
+        /// Also record the joint states as a ROS 2 MCAP file (Foxglove, ros2 bag, rosbags),
+        /// stamped on the audio clock. Also writes robot.urdf.
+        #[arg(long, value_name = "FILE")]
+        mcap: Option<PathBuf>,
         /// The style (tones of the blob).
         #[command(flatten)]
         style: StyleFlags,
@@ -120,6 +133,19 @@ pub enum Command {
         /// Lines `phrase<TAB>label[<TAB>threshold]`.
         #[arg(long, value_name = "FILE")]
         keywords: PathBuf,
+    },
+    /// Write a blob's character as a URDF whose movable joints are named as the JointState
+    /// messages of --ros2 and --mcap name them (robot_state_publisher, RViz, Foxglove).
+    Urdf {
+        /// Policy blob (with its skeleton section).
+        #[arg(long, value_name = "BLOB")]
+        blob: PathBuf,
+        /// Rig file whose calibration (the joint limits) replaces the blob's.
+        #[arg(long, value_name = "RIG")]
+        rig: Option<PathBuf>,
+        /// Output file [default: stdout].
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
     },
     /// The whole pipeline on a fresh clone: synthetic corpus, training, packing, a new
     /// utterance, and `run` on it; then real recorded speech driving a library of real motion
@@ -177,6 +203,13 @@ pub enum Command {
         /// Humanoid bone map for --vmc (overrides the built-in aliases).
         #[arg(long, value_name = "FILE", requires = "vmc")]
         bone_map: Option<PathBuf>,
+        /// Publish the joint states to ROS 2 as sensor_msgs/JointState over DDS as they play
+        /// (feature `ros2`; domain from ROS_DOMAIN_ID).
+        #[arg(long)]
+        ros2: bool,
+        /// The topic of --ros2 [default: /joint_states].
+        #[arg(long, value_name = "TOPIC", requires = "ros2")]
+        ros2_topic: Option<String>,
         /// The style (tones of the blob); a style track's times count from the start.
         #[command(flatten)]
         style: StyleFlags,
@@ -233,6 +266,9 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             vmc,
             bone_map,
             blender,
+            ros2,
+            ros2_topic,
+            mcap,
             style,
             labels,
             keywords,
@@ -248,6 +284,9 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 vmc: vmc.clone(),
                 bone_map: bone_map.clone(),
                 blender: *blender,
+                ros2: *ros2,
+                ros2_topic: ros2_topic.clone(),
+                mcap: mcap.clone(),
                 style: style.clone(),
                 labels: labels.clone(),
                 keywords: keywords.clone(),
@@ -270,6 +309,11 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             }
             Ok(())
         }
+        Command::Urdf {
+            blob,
+            rig,
+            out: file,
+        } => crate::ros2::urdf::run(blob, rig.as_deref(), file.as_deref(), out),
         Command::Demo { out: dir, audio } => Ok(crate::demo::demo(
             dir,
             crate::demo::DemoParams::default(),
@@ -282,6 +326,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             seconds,
             vmc,
             bone_map,
+            ros2,
+            ros2_topic,
             style,
             keywords,
         } => {
@@ -315,6 +361,12 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 Some(addr) => Some(run_cmd::vmc_sender(&b, addr, bone_map.as_deref())?),
                 None => None,
             };
+            let mut publisher = if *ros2 {
+                Some(crate::ros2::start(ros2_topic.as_deref())?)
+            } else {
+                None
+            };
+            let stream = crate::ros2::JointStream::new(&b);
             let mut source = live::CpalSource::open(device.as_deref())?;
             let opts = LiveOptions {
                 seconds: *seconds,
@@ -325,16 +377,30 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                     .then(|| live::read_keys(io::BufReader::new(io::stdin()))),
                 keywords,
             };
-            live::live_loop_with(
-                &b,
-                &mut source,
-                opts,
-                out,
-                &mut |t, pose| match &mut sender {
-                    Some(v) => v.send(t, pose).map_err(|e| e.to_string()),
-                    None => Ok(()),
-                },
-            )?;
+            // Stamps: the audio clock, from the wall-clock time listening started.
+            if let Some(p) = &mut publisher {
+                p.set_origin_ns(crate::ros2::unix_nanos());
+            }
+            live::live_loop_with(&b, &mut source, opts, out, &mut |tick| {
+                if let Some(v) = &mut sender {
+                    v.send(tick.time_s, tick.pose).map_err(|e| e.to_string())?;
+                }
+                if let Some(p) = &mut publisher {
+                    let msg = stream.message(tick.tick, p.origin_ns(), tick.angles);
+                    p.publish(msg).map_err(|e| e.to_string())?;
+                }
+                Ok(())
+            })?;
+            if let Some(p) = &mut publisher {
+                p.finish();
+                writeln!(
+                    out,
+                    "ros2: published {} sensor_msgs/JointState messages on {} (domain {})",
+                    p.sent(),
+                    p.topic(),
+                    p.domain()
+                )?;
+            }
             Ok(())
         }
     }

@@ -58,6 +58,9 @@ pub enum SimError {
     /// `--vmc` could not start or send.
     #[error(transparent)]
     Vmc(#[from] crate::vmc::VmcError),
+    /// `--ros2`, `--mcap` or the URDF could not start, be made or be sent.
+    #[error(transparent)]
+    Ros2(#[from] crate::ros2::Ros2Error),
 }
 
 impl From<RunError> for SimError {
@@ -79,6 +82,7 @@ impl SimError {
             Self::Soak(_) => 1,
             Self::Vmc(crate::vmc::VmcError::Send(_)) => 1,
             Self::Vmc(_) => 2,
+            Self::Ros2(e) => e.exit_code(),
         }
     }
 }

@@ -26,6 +26,8 @@
 //! - [`soak`]: `gesture-sim soak`: hours of hostile audio through a blob's device loop (drift,
 //!   limits, memory).
 //! - [`vmc`]: the played poses to avatar apps over the VMC protocol (OSC over UDP).
+//! - [`ros2`]: robots through ROS 2: `sensor_msgs/JointState` over DDS (`--ros2`, feature
+//!   `ros2`), in an MCAP file (`--mcap`), and the character as a URDF (`gesture-sim urdf`).
 //! - [`style`]: `--style`, `--energy`, `--style-track`: the tone weights of a run.
 //! - [`labels`]: `--labels`: semantic labels at audio times.
 //! - [`kws`]: `--keywords`: keyword spotting with CMU PocketSphinx (feature `kws`), the only
@@ -44,6 +46,7 @@ pub mod labels;
 pub mod live;
 pub mod metrics_cmd;
 pub mod prosody_cmd;
+pub mod ros2;
 pub mod run;
 pub mod servo;
 pub mod soak;

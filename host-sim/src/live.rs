@@ -216,14 +216,28 @@ pub fn live_loop(
     opts: LiveOptions,
     out: &mut dyn Write,
 ) -> Result<LiveStats, LiveError> {
-    live_loop_with(blob, source, opts, out, &mut |_, _| Ok(()))
+    live_loop_with(blob, source, opts, out, &mut |_| Ok(()))
 }
 
-/// Receives each played pose: its time (s from the start) and channel values.
-pub type PoseSink<'a> = dyn FnMut(f64, &[f32]) -> Result<(), String> + 'a;
+/// One animation tick as it plays.
+#[derive(Clone, Copy, Debug)]
+pub struct PlayedTick<'a> {
+    /// The tick.
+    pub tick: u64,
+    /// Its time (s from the start of listening).
+    pub time_s: f64,
+    /// The played pose (rig channel values, degrees).
+    pub pose: &'a [f32],
+    /// The angles the servo rig commanded for it (degrees: the pose within the blob's limits
+    /// and slew rate).
+    pub angles: &'a [f32],
+}
 
-/// [`live_loop`], handing every pose (its time in seconds from the start, channel values) to
-/// `on_pose` as it is played (e.g. a VMC sender); its error stops the loop.
+/// Receives each played tick.
+pub type PoseSink<'a> = dyn FnMut(PlayedTick<'_>) -> Result<(), String> + 'a;
+
+/// [`live_loop`], handing every tick ([`PlayedTick`]) to `on_pose` as it is played (e.g. a
+/// VMC sender or a ROS 2 publisher); its error stops the loop.
 pub fn live_loop_with(
     blob: &Blob<'_>,
     source: &mut dyn AudioSource,
@@ -232,6 +246,8 @@ pub fn live_loop_with(
     on_pose: &mut PoseSink<'_>,
 ) -> Result<LiveStats, LiveError> {
     let mut pose_err: Option<String> = None;
+    let mut last_pose: Vec<f32> = Vec::with_capacity(blob.channels());
+    let channels = blob.channels();
     let config = blob.prosody_config();
     let rate = config.sample_rate_hz;
     let mut slot = Box::new(None);
@@ -331,8 +347,21 @@ pub fn live_loop_with(
         }
         // Null pins cannot fail.
         let _ = device.push(&pcm, &mut |e| {
-            let DeviceEvent::Controller(e) = e else {
-                return;
+            let e = match e {
+                DeviceEvent::Controller(e) => e,
+                // The servos follow the tick's pose event: both go to the sink together.
+                DeviceEvent::Servos { tick, rig } => {
+                    if pose_err.is_none() {
+                        pose_err = on_pose(PlayedTick {
+                            tick,
+                            time_s: tick as f64 / fps.max(1e-9),
+                            pose: &last_pose,
+                            angles: &rig.angles()[..channels],
+                        })
+                        .err();
+                    }
+                    return;
+                }
             };
             let r = match e {
                 ControllerEvent::Step { step, belief } => {
@@ -377,9 +406,8 @@ pub fn live_loop_with(
                 }
                 ControllerEvent::Pose { tick, pose, .. } => {
                     stats.ticks = tick + 1;
-                    if pose_err.is_none() {
-                        pose_err = on_pose(tick as f64 / fps.max(1e-9), pose).err();
-                    }
+                    last_pose.clear();
+                    last_pose.extend_from_slice(pose);
                     Ok(())
                 }
                 ControllerEvent::Label {

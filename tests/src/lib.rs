@@ -59,6 +59,63 @@ pub fn skip(test: &str, why: &str) {
     eprintln!("skipping {test}: {why}");
 }
 
+/// Set (to anything) to turn every skip of a ROS 2 interoperability test into a failure (CI
+/// sets it after installing the Python packages those tests decode with).
+pub const REQUIRE_ROS2_ENV: &str = "GESTURE_REQUIRE_ROS2";
+
+/// Overrides where the ROS 2 tests' Python is (default: [`ros2_venv`]`/bin/python`).
+pub const ROS2_PYTHON_ENV: &str = "GESTURE_ROS2_PYTHON";
+
+/// The Python packages the ROS 2 tests import (PyPI names: cyclonedds, rosbags, mcap,
+/// mcap-ros2-support, urdf-parser-py, and numpy with them).
+pub const ROS2_PYTHON_MODULES: &str = "cyclonedds, rosbags, mcap, mcap_ros2, urdf_parser_py, numpy";
+
+/// The virtual environment `.ci/run` installs the ROS 2 tests' Python packages into.
+pub fn ros2_venv() -> PathBuf {
+    repo_root().join("target/ros2-venv")
+}
+
+/// The Python that has the ROS 2 tests' packages ([`ROS2_PYTHON_MODULES`]): that of
+/// [`ROS2_PYTHON_ENV`] or of [`ros2_venv`]. Otherwise prints `skipping <test>: <why>` and
+/// returns `None`, or panics if [`REQUIRE_ROS2_ENV`] is set.
+pub fn ros2_python(test: &str) -> Option<PathBuf> {
+    let python = std::env::var_os(ROS2_PYTHON_ENV)
+        .map_or_else(|| ros2_venv().join("bin/python"), PathBuf::from);
+    if !python.exists() {
+        skip_ros2(
+            test,
+            &format!(
+                "{} is absent (python3 -m venv {v} && {v}/bin/pip install cyclonedds rosbags \
+                 mcap mcap-ros2-support urdf-parser-py; .ci/run does it)",
+                python.display(),
+                v = ros2_venv().display()
+            ),
+        );
+        return None;
+    }
+    let ok = std::process::Command::new(&python)
+        .args(["-c", &format!("import {ROS2_PYTHON_MODULES}")])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !ok {
+        skip_ros2(
+            test,
+            &format!("{} cannot import {ROS2_PYTHON_MODULES}", python.display()),
+        );
+        return None;
+    }
+    Some(python)
+}
+
+/// Reports a skipped ROS 2 test; panics under [`REQUIRE_ROS2_ENV`].
+pub fn skip_ros2(test: &str, why: &str) {
+    if std::env::var_os(REQUIRE_ROS2_ENV).is_some() {
+        panic!("{test}: ROS 2 tools required ({REQUIRE_ROS2_ENV} is set) but {why}");
+    }
+    eprintln!("skipping {test}: {why}");
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

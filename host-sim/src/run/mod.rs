@@ -22,7 +22,9 @@
 //! - `viewer.html`, a self-contained page that plays the skeleton with the speech ([`viewer`]);
 //! - `preview.mp4`, the run as a video with the speech, through `ffmpeg` ([`video`]);
 //! - with `--blender`, `blender.py` and `speech.wav` ([`blender`]);
-//! - with `--vmc HOST:PORT`, the poses streamed to an avatar app ([`crate::vmc`]).
+//! - with `--vmc HOST:PORT`, the poses streamed to an avatar app ([`crate::vmc`]);
+//! - with `--ros2` (feature `ros2`) or `--mcap FILE`, the joint states as
+//!   `sensor_msgs/JointState` over DDS or in an MCAP file, and `robot.urdf` ([`crate::ros2`]).
 //!
 //! The summary on stdout gives the files, the audio duration, the decisions, the median and
 //! maximum syllable detection latency and the simulation speed as a multiple of real time
@@ -75,6 +77,12 @@ pub struct RunConfig {
     pub bone_map: Option<PathBuf>,
     /// Also write `blender.py` and `speech.wav` ([`blender`]).
     pub blender: bool,
+    /// Publish the joint states over ROS 2 DDS ([`crate::ros2`]).
+    pub ros2: bool,
+    /// The topic of `ros2` and `mcap` (default `/joint_states`).
+    pub ros2_topic: Option<String>,
+    /// Record the joint states in this MCAP file.
+    pub mcap: Option<PathBuf>,
     /// The style and its changes over time ([`crate::style`]).
     pub style: crate::style::StyleFlags,
     /// Semantic labels at audio times (`--labels CSV`; [`crate::labels`]).
@@ -119,6 +127,14 @@ pub enum RunError {
     /// The style or label options do not fit the blob.
     #[error("{0}")]
     Style(String),
+    /// The MCAP path is a folder, or its folder does not exist.
+    #[error("--mcap {}: {reason}", path.display())]
+    McapPath {
+        /// The path.
+        path: PathBuf,
+        /// What is wrong.
+        reason: &'static str,
+    },
     /// The output path exists and is not a folder.
     #[error("{}: exists and is not a folder (give a folder for the outputs)", path.display())]
     OutNotDir {
@@ -165,6 +181,7 @@ impl RunError {
             | Self::RigMismatch { .. }
             | Self::Audio(_)
             | Self::OutNotDir { .. }
+            | Self::McapPath { .. }
             | Self::Style(_)
             | Self::Overwrite(_) => 2,
             Self::Sim(_) | Self::Render { .. } | Self::Write { .. } => 1,
@@ -248,6 +265,8 @@ pub struct Outputs {
     pub bvh_frames: usize,
     /// Lines for the summary about outputs that were not made (e.g. no `ffmpeg`).
     pub notes: Vec<String>,
+    /// What the summary says after `robot.urdf` and after the MCAP file.
+    pub ros_details: (String, String),
 }
 
 /// `servo.csv` of a run.
@@ -269,7 +288,7 @@ pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
 }
 
 /// Every file a run may write into its folder.
-pub const OUTPUT_NAMES: [&str; 9] = [
+pub const OUTPUT_NAMES: [&str; 10] = [
     "motion.bvh",
     "timeline.json",
     "servo.csv",
@@ -279,6 +298,7 @@ pub const OUTPUT_NAMES: [&str; 9] = [
     "preview.mp4",
     "speech.wav",
     "blender.py",
+    "robot.urdf",
 ];
 
 /// Renders every output of a run (`samples`: the speech at the blob's rate, for
@@ -347,6 +367,7 @@ pub fn render(
         files,
         bvh_frames,
         notes,
+        ros_details: Default::default(),
     })
 }
 
@@ -402,7 +423,11 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     }
     // No output may replace an input (e.g. --out the audio's folder with the audio named
     // speech.wav, which --blender writes).
-    let outputs: Vec<PathBuf> = OUTPUT_NAMES.iter().map(|n| cfg.out.join(n)).collect();
+    let mut outputs: Vec<PathBuf> = OUTPUT_NAMES.iter().map(|n| cfg.out.join(n)).collect();
+    if let Some(m) = &cfg.mcap {
+        check_mcap_path(m)?;
+        outputs.push(m.clone());
+    }
     let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
     let mut inputs: Vec<&Path> = vec![&cfg.blob, &cfg.audio];
     inputs.extend(cfg.rig.as_deref());
@@ -434,6 +459,13 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         Some(addr) => Some(vmc_sender(&blob, addr, cfg.bone_map.as_deref())?),
         None => None,
     };
+    let topic = crate::ros2::full_topic(cfg.ros2_topic.as_deref())?;
+    // Started before the simulation, so DDS discovery runs meanwhile.
+    let mut publisher = if cfg.ros2 {
+        Some(crate::ros2::start(Some(&topic))?)
+    } else {
+        None
+    };
     let chunk = ((cfg.chunk_ms / 1000.0 * rate as f64).round() as usize).max(1);
     if let Some((kw, index)) = &keywords {
         if rate != 16_000 {
@@ -458,8 +490,8 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         period_us,
         SimOptions {
             chunk,
-            // With --vmc the poses are paced as they are sent instead.
-            realtime: cfg.realtime && vmc.is_none(),
+            // With --vmc or --ros2 the poses are paced as they are sent instead.
+            realtime: cfg.realtime && vmc.is_none() && publisher.is_none(),
         },
         &styles,
         &labels,
@@ -504,10 +536,68 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
                 .push(("blender.py", blender::SCRIPT.as_bytes().to_vec()));
         }
     }
-    if let Some(v) = &mut vmc {
-        stream_vmc(v, &sim, cfg.realtime)?;
+    let stream = crate::ros2::JointStream::new(&blob);
+    if cfg.ros2 || cfg.mcap.is_some() {
+        match crate::ros2::urdf::Robot::from_blob(&blob, &cals) {
+            Ok(robot) => {
+                outputs.ros_details.0 = format!(
+                    " ({} movable joints{})",
+                    robot.movable().len(),
+                    robot.note()
+                );
+                outputs
+                    .files
+                    .push(("robot.urdf", robot.to_xml().into_bytes()));
+            }
+            Err(e) => outputs.notes.push(format!("no robot.urdf: {e}")),
+        }
     }
-    let written = write_all(&cfg.out, &outputs.files)?;
+    outputs.ros_details.1 = format!(
+        " ({} sensor_msgs/JointState messages on {topic}, stamped on the audio clock)",
+        sim.angles.len()
+    );
+    let mcap = match &cfg.mcap {
+        Some(path) => Some((
+            path,
+            crate::ros2::recording::mcap_bytes(&stream, &topic, &sim.angles).map_err(|reason| {
+                crate::ros2::Ros2Error::Mcap {
+                    path: path.clone(),
+                    reason,
+                }
+            })?,
+        )),
+        None => None,
+    };
+    if vmc.is_some() || publisher.is_some() {
+        stream_out(
+            &sim,
+            cfg.realtime,
+            vmc.as_mut(),
+            publisher.as_mut().map(|p| (p, &stream)),
+        )?;
+    }
+    let mut written = write_all(&cfg.out, &outputs.files)?;
+    if let Some((path, bytes)) = &mcap {
+        gesture_trainer::output::write_atomic(path, bytes).map_err(|e| RunError::Write {
+            path: e.path,
+            source: e.source,
+        })?;
+        written.push(path.to_path_buf());
+    }
+    if let Some(p) = &publisher {
+        writeln!(
+            out,
+            "ros2: published {} sensor_msgs/JointState messages of {} joints on {} (domain {}, \
+             {}; stamps: the audio clock from Unix time {}.{:09} s)",
+            p.sent(),
+            stream.names().len(),
+            p.topic(),
+            p.domain(),
+            crate::ros2::QOS,
+            p.origin_ns().div_euclid(1_000_000_000),
+            p.origin_ns().rem_euclid(1_000_000_000)
+        )?;
+    }
     if let (Some(v), Some(addr)) = (&vmc, &cfg.vmc) {
         writeln!(
             out,
@@ -529,6 +619,23 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
     Ok(())
 }
 
+/// Refuses an MCAP path that is a folder or whose folder does not exist.
+fn check_mcap_path(path: &Path) -> Result<(), RunError> {
+    let bad = |reason| RunError::McapPath {
+        path: path.to_path_buf(),
+        reason,
+    };
+    if path.is_dir() {
+        return Err(bad("is a folder (give a file name such as run.mcap)"));
+    }
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() && !d.is_dir() => {
+            Err(bad("its folder does not exist"))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// A VMC sender for the blob's skeleton.
 pub fn vmc_sender(
     blob: &Blob<'_>,
@@ -542,21 +649,36 @@ pub fn vmc_sender(
     VmcSender::new(addr, VmcStream::new(sk, map))
 }
 
-/// Sends every pose of `sim`, at its time when `realtime`, else as fast as possible.
-fn stream_vmc(
-    v: &mut crate::vmc::VmcSender,
+/// Sends every tick of `sim` over VMC (its pose) and ROS 2 (its commanded angles, stamped on
+/// the audio clock from the publisher's origin), at its time when `realtime`, else as fast as
+/// possible.
+fn stream_out(
     sim: &Simulation,
     realtime: bool,
-) -> Result<(), crate::vmc::VmcError> {
+    mut vmc: Option<&mut crate::vmc::VmcSender>,
+    mut ros: Option<(&mut crate::ros2::Publisher, &crate::ros2::JointStream)>,
+) -> Result<(), crate::error::SimError> {
     let start = Instant::now();
-    for (k, pose) in sim.poses.iter().enumerate() {
+    if let Some((p, _)) = &mut ros {
+        p.set_origin_ns(crate::ros2::unix_nanos());
+    }
+    for (k, (pose, angles)) in sim.poses.iter().zip(&sim.angles).enumerate() {
         let t = k as f64 / sim.fps.max(1e-9);
         if realtime {
             if let Some(wait) = std::time::Duration::from_secs_f64(t).checked_sub(start.elapsed()) {
                 std::thread::sleep(wait);
             }
         }
-        v.send(t, pose)?;
+        if let Some(v) = &mut vmc {
+            v.send(t, pose)?;
+        }
+        if let Some((p, stream)) = &mut ros {
+            let msg = stream.message(k as u64, p.origin_ns(), angles);
+            p.publish(msg)?;
+        }
+    }
+    if let Some((p, _)) = &mut ros {
+        p.finish();
     }
     Ok(())
 }
@@ -596,6 +718,8 @@ fn summary(
         let extra = match p.file_name().and_then(|n| n.to_str()) {
             Some("motion.bvh") => format!(" ({} frames at {:.2} fps)", outputs.bvh_frames, sim.fps),
             Some("servo.csv") => format!(" ({} ticks)", sim.duties.len()),
+            Some("robot.urdf") => outputs.ros_details.0.clone(),
+            _ if cfg.mcap.as_deref() == Some(p.as_path()) => outputs.ros_details.1.clone(),
             _ => String::new(),
         };
         writeln!(out, "wrote {}{extra}", p.display())?;

@@ -111,6 +111,9 @@ pub struct Simulation {
     pub shown: Vec<(usize, usize)>,
     /// One row of duty cycles per tick, from the virtual servo rig.
     pub duties: Vec<Vec<u16>>,
+    /// One row per tick of the angles (deg) the servo rig commanded: the pose within the
+    /// calibration's limits and slew rate (what `--ros2` and `--mcap` publish).
+    pub angles: Vec<Vec<f32>>,
     /// Wall-clock time of the simulation (s).
     pub wall_s: f64,
     /// The style changes applied, in time order (the first at time 0; neutral if none given).
@@ -346,6 +349,7 @@ fn record(
                     .map(VirtualPin::duty)
                     .collect(),
             );
+            sim.angles.push(rig.angles()[..channels].to_vec());
             return;
         }
         DeviceEvent::Controller(e) => e,
