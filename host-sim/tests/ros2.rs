@@ -59,8 +59,8 @@ fn bvh_states(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>, f64) {
     (names, frames, m.fps())
 }
 
-/// A decoded message's names, positions and stamp equal the reference's frame `k`.
-fn check_message(m: &Value, k: usize, names: &[String], frames: &[Vec<f64>], fps: f64) {
+/// A decoded message's names and positions equal the reference's frame `k`.
+fn check_message(m: &Value, k: usize, names: &[String], frames: &[Vec<f64>]) {
     let got: Vec<&str> = m["name"]
         .as_array()
         .unwrap()
@@ -82,7 +82,6 @@ fn check_message(m: &Value, k: usize, names: &[String], frames: &[Vec<f64>], fps
             names[c]
         );
     }
-    let _ = fps;
 }
 
 fn stamp_ns(m: &Value) -> i64 {
@@ -128,7 +127,7 @@ fn mcap_and_urdf_of_a_run_open_in_ros_tools() {
         );
         for (k, m) in msgs.iter().enumerate() {
             assert_eq!(m["topic"], "/joint_states");
-            check_message(m, k, &names, &frames, fps);
+            check_message(m, k, &names, &frames);
             let t = (k as f64 * 1e9 / fps).round() as i64;
             assert_eq!(stamp_ns(m), t, "{decoder} message {k}");
             assert_eq!(m["log_time"].as_i64().unwrap(), t);
@@ -453,7 +452,7 @@ wait $sub
     let mut prev: Option<(usize, i64)> = None;
     for m in &got {
         let k = tick(m);
-        check_message(m, k, &names, &frames, fps);
+        check_message(m, k, &names, &frames);
         let t = stamp_ns(m);
         assert_eq!(t - origin_ns, (k as f64 * 1e9 / fps).round() as i64);
         if let Some((pk, pt)) = prev {

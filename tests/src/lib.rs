@@ -7,6 +7,10 @@
 //! `../shared/data` is present), a real-data test that would skip fails instead: a missing or
 //! renamed recording can never make CI pass silently.
 //!
+//! The ROS 2 interoperability tests check the simulator's output with third-party Python
+//! tools in a venv ([`ros2_python`]); they skip in the same way when it is absent, and fail
+//! instead when [`REQUIRE_ROS2_ENV`] is set (CI sets it after installing the venv).
+//!
 //! Dependency-free on purpose, so the runtime's, the trainer's and the simulator's tests can
 //! all use it as a dev-dependency.
 
