@@ -89,10 +89,13 @@ pub fn ros2_python(test: &str) -> Option<PathBuf> {
         skip_ros2(
             test,
             &format!(
-                "{} is absent (python3 -m venv {v} && {v}/bin/pip install cyclonedds rosbags \
-                 mcap mcap-ros2-support urdf-parser-py; .ci/run does it)",
+                "{} is absent (python3 -m venv {v} && {v}/bin/pip install -r \
+                 {r}; .ci/run does it)",
                 python.display(),
-                v = ros2_venv().display()
+                v = ros2_venv().display(),
+                r = repo_root()
+                    .join("host-sim/tests/ros2/requirements.txt")
+                    .display()
             ),
         );
         return None;
