@@ -4,13 +4,7 @@
 
 use super::crc::crc32;
 use super::error::BlobError;
-
-/// The first four bytes of every blob.
-pub const MAGIC: [u8; 4] = *b"GSTB";
-/// The format version this runtime reads and writes.
-pub const FORMAT_VERSION: u16 = 7;
-/// Header length in bytes.
-pub const HEADER_LEN: usize = 16;
+use super::format::{FORMAT_VERSION, HEADER_LEN, MAGIC};
 
 /// The fixed 16-byte header.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -14,6 +14,8 @@
 //! module is the format's only implementation: the reader below and, behind the `encode`
 //! feature (host tools), the writer in `encode`, side by side.
 //!
+//! - `format`: the header's constants and the capacities of every section ([`MAX_SEGMENTS`],
+//!   ...);
 //! - `header`: magic, version, flags, length, CRC ([`Header`]);
 //! - `payload`: the wire structs, one per section ([`Payload`]);
 //! - `records`: fixed-size records in the byte tables and their little-endian readers;
@@ -24,6 +26,8 @@
 //! - `tables`: the blob as the controller's [`PolicyTables`](crate::policy::PolicyTables) and
 //!   [`LibraryFrames`](crate::player::LibraryFrames);
 //! - `skeleton`: the host-side skeleton section ([`SkeletonView`], [`BvhChannel`] codes);
+//! - `field`: the sections and fields as docs/blob-format.md names them ([`Section`],
+//!   [`Field`]);
 //! - `error`: [`BlobError`], named by phase and field;
 //! - `encode` (feature `encode`): owned sections, table layout and the
 //!   serializer, checked against [`Blob::parse`].
@@ -44,6 +48,8 @@ mod crc;
 #[cfg(feature = "encode")]
 pub mod encode;
 mod error;
+mod field;
+mod format;
 mod header;
 mod payload;
 mod quantize;
@@ -54,8 +60,10 @@ mod validate;
 mod view;
 
 pub use crc::{crc32, Crc32};
-pub use error::{BlobError, Field, Section};
-pub use header::{Header, FORMAT_VERSION, HEADER_LEN, MAGIC};
+pub use error::BlobError;
+pub use field::{Field, Section};
+pub use format::*;
+pub use header::Header;
 pub use payload::{
     ControlSection, FrontEndSection, I16Section, InferenceSection, LabelsSection, LibrarySection,
     Payload, PolicySection, RigSection, SkeletonSection, StylesSection, CALIBRATION_RECORD_BYTES,
@@ -65,33 +73,5 @@ pub use payload::{
 };
 pub use quantize::{quantize_range, quantize_symmetric, Quantization, QUANT_MAX};
 pub use records::{calibration_from_record, calibration_record, gmm_from_record, gmm_record};
-pub use skeleton::{BvhChannel, Drive, DriveMode, SkeletonView, EULER_ORDERS, MAX_JOINTS};
+pub use skeleton::{BvhChannel, Drive, DriveMode, SkeletonView, EULER_ORDERS};
 pub use view::{Blob, ExitPoint, GmmComponents, SectionSizes, SegmentInfo, Successor, Successors};
-
-/// Most library segments.
-pub const MAX_SEGMENTS: usize = 4096;
-/// Most exit points.
-pub const MAX_EXITS: usize = 16384;
-/// Most output channels (the servo rig's capacity).
-pub const MAX_CHANNELS: usize = crate::rig::MAX_CHANNELS;
-/// Most frames in the library's frame table.
-pub const MAX_FRAMES: usize = 1 << 20;
-/// Highest library frame rate (frames per second).
-pub const MAX_FPS: f32 = 1000.0;
-/// Longest onset window of the `control` section (ms).
-pub const MAX_ONSET_WINDOW_MS: u16 = 1000;
-/// Longest wait for an onset at a segment's end in the `control` section (ms).
-pub const MAX_WAIT_MS: u16 = 5000;
-/// Largest recency or usage cost of the `control` section (cost units).
-pub const MAX_VARIETY_COST: f32 = 1.0e6;
-/// Longest inertialization time of the `control` section (ms).
-pub const MAX_BLEND_MS: u16 = 5000;
-/// Longest hold at a motion beat of the `control` section (ms).
-pub const MAX_BEAT_HOLD_MS: u16 = 1000;
-/// Longest delay of a cut until the hands pause, of the `control` section (ms).
-pub const MAX_DEFER_CUT_MS: u16 = 1000;
-/// Longest silence before resting, of the `control` section (ms).
-pub const MAX_REST_MS: u16 = 10_000;
-/// `library.energy` holds a segment's energy times this, rounded (an `i8`: energies within
-/// +-8, a 1/16 step).
-pub const ENERGY_SCALE: f32 = 16.0;

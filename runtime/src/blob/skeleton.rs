@@ -84,9 +84,6 @@ impl BvhChannel {
     }
 }
 
-/// Most joints a skeleton section may have.
-pub const MAX_JOINTS: usize = 1024;
-
 /// Euler decomposition orders of drive modes 2..=7, as axis indices (0 = X, 1 = Y, 2 = Z):
 /// `XYZ`, `XZY`, `YXZ`, `YZX`, `ZXY`, `ZYX`.
 pub const EULER_ORDERS: [[u8; 3]; 6] = [
@@ -188,7 +185,7 @@ impl<'a> SkeletonView<'a> {
         Self { s }
     }
 
-    /// Joints J (1..=[`MAX_JOINTS`]).
+    /// Joints J (1..=[`MAX_JOINTS`](super::MAX_JOINTS)).
     pub fn joints(&self) -> usize {
         self.s.joints as usize
     }

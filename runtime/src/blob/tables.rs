@@ -2,7 +2,7 @@
 //! [`LibraryFrames`] views. Every index the controller passes was range-checked at load, and
 //! the blob's accessors return neutral values for anything else, so nothing here can panic.
 
-use super::Blob;
+use super::view::Blob;
 use crate::player::LibraryFrames;
 use crate::policy::PolicyTables;
 

@@ -4,14 +4,15 @@
 //! first rule broken; O(payload size), no allocation, no panics (all index arithmetic is
 //! checked or bounded by the capacities).
 
-use super::error::{BlobError, Field};
+use super::error::BlobError;
+use super::field::Field;
+use super::format::{
+    MAX_BEAT_HOLD_MS, MAX_BLEND_MS, MAX_CHANNELS, MAX_DEFER_CUT_MS, MAX_EXITS, MAX_FPS, MAX_FRAMES,
+    MAX_JOINTS, MAX_ONSET_WINDOW_MS, MAX_REST_MS, MAX_SEGMENTS, MAX_VARIETY_COST, MAX_WAIT_MS,
+};
 use super::payload::*;
 use super::records::{calibration_from_record, f32_at, record, u16_at, u32_at};
-use super::skeleton::{Drive, MAX_JOINTS};
-use super::{
-    MAX_BEAT_HOLD_MS, MAX_BLEND_MS, MAX_CHANNELS, MAX_DEFER_CUT_MS, MAX_EXITS, MAX_FPS, MAX_FRAMES,
-    MAX_ONSET_WINDOW_MS, MAX_REST_MS, MAX_SEGMENTS, MAX_VARIETY_COST, MAX_WAIT_MS,
-};
+use super::skeleton::Drive;
 use crate::inference::{CrfWeights, I16Table, MAX_CLUSTERS, MAX_STATES, MAX_WINDOW};
 use crate::rig::validate_period;
 
@@ -346,7 +347,7 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
         let bad = BlobError::BadGroup { group: g as u32 };
         let r = record::<GROUP_RECORD_BYTES>(l.groups, g).ok_or(bad)?;
         let first = u16::from_le_bytes([r[0], r[1]]) as usize;
-        if first < free || first + 3 > ch || r[2] as usize >= super::EULER_ORDERS.len() {
+        if first < free || first + 3 > ch || r[2] as usize >= super::skeleton::EULER_ORDERS.len() {
             return Err(bad);
         }
         free = first + 3;

@@ -7,7 +7,8 @@
 
 use core::num::NonZeroU8;
 
-use super::error::{BlobError, Section};
+use super::error::BlobError;
+use super::field::Section;
 use super::header::Header;
 use super::payload::*;
 use super::records::{
@@ -468,11 +469,9 @@ impl<'a> Blob<'a> {
 
     /// Segment `s`'s energy (`library.energy`; 0 out of range).
     pub fn segment_energy(&self, s: usize) -> f32 {
-        self.payload
-            .library
-            .energy
-            .get(s)
-            .map_or(0.0, |&q| q as i8 as f32 * (1.0 / super::ENERGY_SCALE))
+        self.payload.library.energy.get(s).map_or(0.0, |&q| {
+            q as i8 as f32 * (1.0 / super::format::ENERGY_SCALE)
+        })
     }
 
     /// Rotation groups (records of `library.groups`).
