@@ -43,7 +43,9 @@ impl HalfBand {
             let sinc = sign / (core::f64::consts::PI * k);
             // Blackman window over 32 points so that the outermost taps are not zero.
             let phase = 2.0 * core::f64::consts::PI * k / (TAPS as f64 + 1.0);
-            let w = 0.42 + 0.5 * super::window_cos(phase) + 0.08 * super::window_cos(2.0 * phase);
+            let w = 0.42
+                + 0.5 * super::frame::window_cos(phase)
+                + 0.08 * super::frame::window_cos(2.0 * phase);
             let h = sinc * w;
             *c = h as f32;
             sum += 2.0 * h;

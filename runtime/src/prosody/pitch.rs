@@ -209,7 +209,7 @@ impl PitchAnalyzer {
         self.hann.fill(0.0);
         for (i, h) in self.hann.iter_mut().take(window_len).enumerate() {
             let phase = (i + 1) as f64 * 2.0 * core::f64::consts::PI / (window_len + 1) as f64;
-            *h = (0.5 - 0.5 * super::window_cos(phase)) as f32;
+            *h = (0.5 - 0.5 * super::frame::window_cos(phase)) as f32;
         }
         self.params = params;
         self.rate = rate;

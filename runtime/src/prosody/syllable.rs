@@ -88,15 +88,15 @@ pub struct Step {
 impl Step {
     /// Start time in seconds.
     pub fn start_s(&self) -> f64 {
-        self.start_frame as f64 * super::HOP_S
+        self.start_frame as f64 * super::frame::HOP_S
     }
     /// End time in seconds.
     pub fn end_s(&self) -> f64 {
-        self.end_frame as f64 * super::HOP_S
+        self.end_frame as f64 * super::frame::HOP_S
     }
     /// Length in seconds.
     pub fn length_s(&self) -> f32 {
-        (self.end_frame.saturating_sub(self.start_frame)) as f32 * super::HOP_S as f32
+        (self.end_frame.saturating_sub(self.start_frame)) as f32 * super::frame::HOP_S as f32
     }
 }
 
