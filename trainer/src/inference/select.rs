@@ -36,9 +36,8 @@ use super::crf::{Crf, CrfConfig, TrainSeq};
 use super::gaussian::log_sum_exp;
 use super::gmm::Gmm;
 use super::hmm::{Hmm, Seq};
-use super::train::{
-    fit_gmm, fit_hmm, memberships, normalized, train_seqs, FitConfig, FitError, Sequence,
-};
+use super::layers::{fit_gmm, fit_hmm, memberships, normalized, train_seqs, FitConfig, FitError};
+use super::sequence::Sequence;
 use crate::motion::Normalization;
 
 /// Corpora up to this many steps get five folds; larger ones one held-out third.
