@@ -39,15 +39,10 @@
 //! a second in release builds (see the `parse_speed` test).
 //!
 
-/// Shortest accepted frame time (s): 1000 frames per second.
-pub const MIN_FRAME_TIME_S: f64 = 0.001;
-/// Longest accepted frame time (s): 1 frame per second.
-pub const MAX_FRAME_TIME_S: f64 = 1.0;
-
 use std::io;
 use std::path::Path;
 
-use super::skeleton::{Channel, Joint, Motion, Skeleton};
+use super::skeleton::{Channel, Joint, Motion, Skeleton, MAX_FRAME_TIME_S, MIN_FRAME_TIME_S};
 
 /// Why a BVH file could not be read.
 #[derive(Debug, thiserror::Error)]

@@ -10,6 +10,11 @@
 //! [`Motion::new`] enforce this, and the fields are private, so forward kinematics and the
 //! writer can rely on it without re-checking.
 
+/// Shortest accepted frame time (s): 1000 frames per second.
+pub const MIN_FRAME_TIME_S: f64 = 0.001;
+/// Longest accepted frame time (s): 1 frame per second.
+pub const MAX_FRAME_TIME_S: f64 = 1.0;
+
 pub use gesture_runtime::blob::BvhChannel as Channel;
 
 /// One joint of a [`Skeleton`].
@@ -170,9 +175,7 @@ impl Motion {
         data: Vec<f64>,
     ) -> Result<Motion, MotionError> {
         skeleton.validate()?;
-        if !(super::bvh_read::MIN_FRAME_TIME_S..=super::bvh_read::MAX_FRAME_TIME_S)
-            .contains(&frame_time)
-        {
+        if !(MIN_FRAME_TIME_S..=MAX_FRAME_TIME_S).contains(&frame_time) {
             return Err(MotionError::BadFrameTime(frame_time));
         }
         let channels = skeleton.channel_count();
