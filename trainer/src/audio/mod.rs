@@ -41,15 +41,11 @@ use hound::{SampleFormat, WavReader};
 mod resample;
 
 use resample::resample;
-pub use resample::StreamResampler;
+pub use resample::{converted_len, ConvertError, StreamResampler, MAX_RATE_HZ, MIN_RATE_HZ};
 
 /// Most channels a loaded file may have (stereo).
 pub const MAX_CHANNELS: usize = 2;
 
-/// Lowest accepted file (and target) sample rate in Hz.
-pub const MIN_RATE_HZ: u32 = 8_000;
-/// Highest accepted file (and target) sample rate in Hz.
-pub const MAX_RATE_HZ: u32 = 48_000;
 /// The default target rate: the front-end's default rate.
 pub const DEFAULT_TARGET_RATE_HZ: u32 = gesture_runtime::prosody::DEFAULT_RATE_HZ;
 
@@ -107,17 +103,6 @@ impl Pcm {
     pub fn duration_s(&self) -> f64 {
         self.samples.len() as f64 / self.rate_hz as f64
     }
-}
-
-/// Why in-memory samples could not be converted by [`convert`].
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum ConvertError {
-    /// The source or target rate is outside [`MIN_RATE_HZ`]..=[`MAX_RATE_HZ`].
-    #[error("sample rate {0} Hz outside {MIN_RATE_HZ}-{MAX_RATE_HZ} Hz")]
-    UnsupportedRate(u32),
-    /// The resampler refused the job (a bug: the rates were checked before).
-    #[error("resampler failed: {0}")]
-    Resampler(String),
 }
 
 /// Why a WAV file could not be loaded. `Display` is one line: `<file>: <reason>`.
@@ -280,12 +265,6 @@ pub fn convert(
     let clean: Vec<f32> = samples.iter().map(|&x| finite_or_zero(x)).collect();
     let resampled = resample(&clean, rate_hz, target_rate_hz)?;
     Ok(resampled.iter().map(|&x| to_i16(x)).collect())
-}
-
-/// Output length of a conversion: `round(len * to / from)`, in exact integer arithmetic.
-pub fn converted_len(len: usize, from_hz: u32, to_hz: u32) -> usize {
-    let num = len as u128 * to_hz as u128;
-    ((num + from_hz as u128 / 2) / from_hz as u128) as usize
 }
 
 fn finite_or_zero(x: f32) -> f32 {

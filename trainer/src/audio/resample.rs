@@ -1,12 +1,33 @@
 //! Band-limited resampling with rubato's asynchronous sinc interpolator, in two forms: a whole
 //! clip with its delay trimmed and its length set exactly (WAV files: timing preserved to
 //! half an output frame), and a stream (the live microphone: a shorter kernel for less delay,
-//! about 1.3 ms at 48 kHz). One place for both, with one set of kernel settings.
+//! about 1.3 ms at 48 kHz). One place for both, with one set of kernel settings; and the
+//! rates accepted, the output length of a conversion and its error.
 
 use rubato::audioadapter_buffers::direct::SequentialSliceOfSlices;
 use rubato::{Async, FixedAsync, Resampler, SincInterpolationParameters, WindowFunction};
 
-use super::{converted_len, ConvertError, MAX_RATE_HZ, MIN_RATE_HZ};
+/// Lowest accepted file (and target) sample rate in Hz.
+pub const MIN_RATE_HZ: u32 = 8_000;
+/// Highest accepted file (and target) sample rate in Hz.
+pub const MAX_RATE_HZ: u32 = 48_000;
+
+/// Why in-memory samples could not be converted by [`convert`](super::convert).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConvertError {
+    /// The source or target rate is outside [`MIN_RATE_HZ`]..=[`MAX_RATE_HZ`].
+    #[error("sample rate {0} Hz outside {MIN_RATE_HZ}-{MAX_RATE_HZ} Hz")]
+    UnsupportedRate(u32),
+    /// The resampler refused the job (a bug: the rates were checked before).
+    #[error("resampler failed: {0}")]
+    Resampler(String),
+}
+
+/// Output length of a conversion: `round(len * to / from)`, in exact integer arithmetic.
+pub fn converted_len(len: usize, from_hz: u32, to_hz: u32) -> usize {
+    let num = len as u128 * to_hz as u128;
+    ((num + from_hz as u128 / 2) / from_hz as u128) as usize
+}
 
 /// Sinc filter length of the resampler (taps).
 const SINC_LEN: usize = 256;
