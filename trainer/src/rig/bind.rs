@@ -7,7 +7,7 @@
 use gesture_runtime::blob::{BvhChannel, Drive, DriveMode};
 use gesture_runtime::rotation::{euler_angles, identity, mat_mul, twist_deg, wrap_deg, Mat3};
 
-use super::{AngleMode, Axis, Rig, RigChannel, RigError};
+use super::spec::{AngleMode, Axis, Rig, RigChannel, RigError};
 use crate::motion::fk::local_transform;
 use crate::motion::{Motion, Skeleton};
 

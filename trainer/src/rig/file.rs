@@ -9,7 +9,7 @@ use gesture_runtime::rig::{validate_period, ChannelCal, MAX_CHANNELS};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 
-use super::{parse_order, AngleMode, Axis, JointAlias, Rig, RigChannel, RigError};
+use super::spec::{parse_order, AngleMode, Axis, JointAlias, Rig, RigChannel, RigError};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -31,7 +31,7 @@ use gesture_runtime::rotation::{
     axis_rotation, euler_angles, euler_matrix, identity, mat_mul, transpose, twist_deg, Mat3,
 };
 
-use super::Axis;
+use super::spec::Axis;
 use crate::motion::fk::local_transform;
 use crate::motion::{Joint, Motion, MotionError, Skeleton};
 
