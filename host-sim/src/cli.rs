@@ -292,7 +292,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 keywords: keywords.clone(),
             },
             out,
-        ),
+        )
+        .map_err(SimError::from),
         Command::Devices => Ok(live::devices(out)?),
         Command::Soak { blob, hours, seed } => crate::soak::run(blob, *hours, *seed, out),
         Command::Metrics { dir, mocap, json } => {

@@ -163,6 +163,12 @@ pub enum RunError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// `--vmc` could not start or send.
+    #[error(transparent)]
+    Vmc(#[from] crate::vmc::VmcError),
+    /// The summary could not be written.
+    #[error("writing output: {0}")]
+    Summary(#[from] std::io::Error),
 }
 
 impl From<RigError> for RunError {
@@ -184,7 +190,9 @@ impl RunError {
             | Self::McapPath { .. }
             | Self::Style(_)
             | Self::Overwrite(_) => 2,
-            Self::Sim(_) | Self::Render { .. } | Self::Write { .. } => 1,
+            Self::Sim(_) | Self::Render { .. } | Self::Write { .. } | Self::Summary(_) => 1,
+            Self::Vmc(crate::vmc::VmcError::Send(_)) => 1,
+            Self::Vmc(_) => 2,
         }
     }
 }
@@ -412,14 +420,13 @@ pub fn keyword_labels(
 }
 
 /// Runs the command; the summary goes to `out`.
-pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::SimError> {
+pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
     let total = Instant::now();
     // Inputs first: nothing is written unless all of them are usable.
     if cfg.out.exists() && !cfg.out.is_dir() {
         return Err(RunError::OutNotDir {
             path: cfg.out.clone(),
-        }
-        .into());
+        });
     }
     // No output may replace an input (e.g. --out the audio's folder with the audio named
     // speech.wav, which --blender writes).
@@ -471,8 +478,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), crate::error::Si
         if rate != 16_000 {
             return Err(RunError::Style(format!(
                 "--keywords: the recognizer listens at 16000 Hz, the blob at {rate} Hz"
-            ))
-            .into());
+            )));
         }
         for d in crate::kws::spot(&pcm.samples, chunk, kw).map_err(RunError::Style)? {
             labels.push(crate::run::sim::LabelPush {
