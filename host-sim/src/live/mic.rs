@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use super::{AudioSource, LiveError};
+use super::source::{AudioSource, LiveError};
 
 /// Runs `f` with ALSA's stderr diagnostics captured (Linux), so a failure is our one line.
 fn quiet_alsa<T>(f: impl FnOnce() -> T) -> T {
