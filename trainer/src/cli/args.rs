@@ -3,7 +3,7 @@
 
 use gesture_runtime::controller::DecisionTiming;
 
-use super::CliError;
+use super::exit::CliError;
 
 /// A finite number in `lo..=hi`, or the reason it is not (clap prints it with the flag).
 pub fn bounded(s: &str, lo: f64, hi: f64) -> Result<f64, String> {

@@ -34,7 +34,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use super::args::{parse_span, CorpusArgs, ModelArgs};
-use super::CliError;
+use super::exit::CliError;
 use crate::corpus::load_corpus;
 use crate::inference::eval::{self, CvReport, EvalReport, PlantedRuns};
 use crate::inference::train::{cv_split_levels, pooled_levels, sequences_with_levels, take_levels};

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use super::args::{parse_span, ControlArgs, CorpusArgs, DeviceArgs};
-use super::CliError;
+use super::exit::CliError;
 use crate::evaluate::metrics::MotionMetrics;
 use crate::evaluate::motion::{evaluate_motion, Evaluation, MotionEval};
 use crate::evaluate::table::motion_table;

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::args::{parse_span, ControlArgs, CorpusArgs, DeviceArgs, StyleArgs};
-use super::CliError;
+use super::exit::CliError;
 use crate::evaluate::motion::MotionEval;
 use crate::evaluate::style::evaluate_styles;
 use crate::inference::model::InferenceModel;

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::args::{parse_span, CorpusArgs, ModelArgs};
-use super::CliError;
+use super::exit::CliError;
 use crate::corpus::load_corpus;
 use crate::inference::train::{fit, sequences};
 

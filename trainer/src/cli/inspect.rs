@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use gesture_runtime::blob::Blob;
 
-use super::CliError;
+use super::exit::CliError;
 
 /// Arguments of `inspect`.
 #[derive(Debug, clap::Args)]

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use super::args::{ControlArgs, CorpusArgs, DeviceArgs, LabelArgs, StyleArgs};
-use super::CliError;
+use super::exit::CliError;
 use crate::output::write_atomic;
 use crate::pack::{pack, PackOptions};
 

@@ -6,7 +6,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use super::args::CorpusArgs;
-use super::CliError;
+use super::exit::CliError;
 use crate::corpus::discover;
 use crate::corpus::stats::{take_stats, TakeStats};
 use crate::progress::progress_bar;

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::{ensure_dir, CliError};
+use super::exit::{ensure_dir, CliError};
 use crate::progress::progress_bar;
 use crate::synth::{write_corpus, SynthParams};
 
