@@ -3,7 +3,7 @@
 //! syllables and the segment entries), the same figures `gesture-train eval-motion` gives
 //! (`gesture_trainer::evaluate::metrics`). Any device that writes the same two files can be
 //! judged this way. With `--mocap`, the hands' speeds are compared with a capture's, as the
-//! character shows it (no walking: `gesture_trainer::evaluate::motion::shown_speed_histogram`).
+//! character shows it (no walking: `gesture_trainer::evaluate::reference::shown_speed_histogram`).
 //!
 //! The voice figures (`gesture_trainer::evaluate::voice`) need the speech's samples: the
 //! run's `speech.wav` when the folder has one (`run --blender` writes it), else the audio file
@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 use gesture_trainer::audio::load_wav_at;
 use gesture_trainer::evaluate::metrics::{measure, Entry, MotionMetrics, Speech, Trace};
-use gesture_trainer::evaluate::motion::shown_speed_histogram;
+use gesture_trainer::evaluate::reference::shown_speed_histogram;
 use gesture_trainer::evaluate::table::motion_table;
 use gesture_trainer::motion::{read_bvh, EffectorSpec};
 use serde::Deserialize;

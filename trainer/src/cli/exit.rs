@@ -110,9 +110,9 @@ impl ExitKind for crate::pack::PackError {
         crate::pack::PackError::is_input(self)
     }
 }
-impl ExitKind for crate::evaluate::motion::EvalError {
+impl ExitKind for crate::evaluate::error::EvalError {
     fn is_input(&self) -> bool {
-        crate::evaluate::motion::EvalError::is_input(self)
+        crate::evaluate::error::EvalError::is_input(self)
     }
 }
 

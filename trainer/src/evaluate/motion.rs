@@ -43,27 +43,24 @@
 use std::path::PathBuf;
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{BlobController, ControllerEvent};
-use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::inference::StepNormalizer;
-use gesture_runtime::player::{LibraryFrames, Player, MAX_CHANNELS};
+use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::{Choice, Variety};
-use gesture_runtime::prosody::{ProsodyConfig, Step, StepKind};
-use rand::seq::SliceRandom;
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
+use gesture_runtime::prosody::ProsodyConfig;
 use serde::Serialize;
 
-use super::metrics::{
-    entries_from_frames, measure, speed_histogram, speed_histogram_where, Entry, MotionMetrics,
-    Speech, Trace,
-};
+use super::error::EvalError;
+use super::metrics::{measure, MotionMetrics, Speech};
+use super::playback::{play_delayed, play_schedule, shuffle_blocks, Playback};
+use super::reference::{shown_speed_histogram, speech_matched_reference};
+use super::signals::speed_histogram;
+use super::trace::{entries_from_frames, Entry, Trace};
 use crate::control::mdp::Action;
-use crate::control::schedule::{play_dp, play_random, Played};
+use crate::control::schedule::{play_dp, play_random};
 use crate::inference::model::InferenceModel;
 use crate::inference::train::prosody_point;
-use crate::motion::{analyze, read_bvh, EffectorSpec, Motion, SegmentParams};
-use crate::pack::{hold_lower_bodies, pack_model, PackError, PackOptions};
+use crate::motion::{analyze, read_bvh, Motion, SegmentParams};
+use crate::pack::{pack_model, PackOptions};
 use crate::rig::PoseSkeleton;
 
 /// What to evaluate.
@@ -158,131 +155,6 @@ pub struct Evaluation {
     pub seconds: f64,
 }
 
-/// Why an evaluation failed.
-#[derive(Debug, thiserror::Error)]
-pub enum EvalError {
-    /// Packing the model and library.
-    #[error(transparent)]
-    Pack(#[from] PackError),
-    /// Reading the audio.
-    #[error(transparent)]
-    Audio(#[from] crate::audio::AudioError),
-    /// Reading the motion capture.
-    #[error(transparent)]
-    Bvh(#[from] crate::motion::BvhError),
-    /// Analysing motion, speech or the options.
-    #[error("{0}")]
-    Input(String),
-    /// The device refused the packed blob or a pose could not be rebuilt (a packer bug).
-    #[error("the packed blob: {0}")]
-    Device(String),
-}
-
-impl EvalError {
-    /// Whether the user's input is at fault.
-    pub fn is_input(&self) -> bool {
-        match self {
-            Self::Pack(e) => e.is_input(),
-            Self::Device(_) => false,
-            _ => true,
-        }
-    }
-}
-
-/// What a playback showed: per tick the pose, and the segment and frame it came from.
-#[derive(Clone, Debug, Default)]
-pub struct Playback {
-    /// One pose per tick (rig channels, degrees).
-    pub poses: Vec<Vec<f32>>,
-    /// Per tick, (segment, frame) shown.
-    pub shown: Vec<(usize, usize)>,
-}
-
-/// One online decision: exit, choice, and the belief it was made with.
-#[derive(Clone, Debug)]
-pub(crate) struct Made {
-    exit: usize,
-    choice: Choice,
-    belief: Vec<f64>,
-}
-
-/// Runs the blob's device loop on `samples` (starting at segment 0), after `setup` on its
-/// controller; returns the first `frames` ticks (the last one repeated if the audio ends
-/// earlier) and the decisions.
-pub(crate) fn play_online(
-    blob: &Blob<'_>,
-    samples: &[i16],
-    frames: usize,
-    setup: impl FnOnce(&mut BlobController<'_>),
-) -> Result<(Playback, Vec<Made>), EvalError> {
-    let mut slot = Box::new(None);
-    let controller = BlobController::from_blob_in(&mut slot, blob)
-        .map_err(|e| EvalError::Device(e.to_string()))?;
-    setup(controller);
-    let mut device: Device<'_, '_, NullPin, MAX_CHANNELS> =
-        Device::new(controller, [NullPin; MAX_CHANNELS])
-            .map_err(|e| EvalError::Device(e.to_string()))?;
-    let mut out = Playback::default();
-    let mut made = Vec::new();
-    let states = blob.states();
-    let mut belief: Vec<f64> = vec![1.0 / states as f64; states];
-    // Null pins cannot fail.
-    let _ = device.push(samples, &mut |ev| match ev {
-        DeviceEvent::Controller(ControllerEvent::Pose {
-            pose,
-            segment,
-            frame,
-            ..
-        }) => {
-            out.poses.push(pose.to_vec());
-            out.shown.push((segment, frame));
-        }
-        DeviceEvent::Controller(ControllerEvent::Step { belief: b, .. }) => {
-            belief = b.iter().map(|&v| v as f64).collect();
-        }
-        DeviceEvent::Controller(ControllerEvent::Decision { decision, .. }) => made.push(Made {
-            exit: decision.exit,
-            choice: decision.choice,
-            belief: belief.clone(),
-        }),
-        _ => {}
-    });
-    hold_to(&mut out, frames);
-    Ok((out, made))
-}
-
-/// Truncates or extends (repeating the last tick) a playback to `frames` ticks.
-fn hold_to(p: &mut Playback, frames: usize) {
-    p.poses.truncate(frames);
-    p.shown.truncate(frames);
-    if let (Some(pose), Some(&shown)) = (p.poses.last().cloned(), p.shown.last()) {
-        p.poses.resize(frames, pose);
-        p.shown.resize(frames, shown);
-    }
-}
-
-/// Plays a schedule of library frames through the runtime's player over the blob's frames,
-/// with the blob's inertialization at every entry.
-pub fn play_schedule(blob: &Blob<'_>, schedule: &[Played]) -> Playback {
-    let mut player = Player::new();
-    let blend = (blob.blend_ms() as f64 * blob.fps() as f64 / 1000.0).ceil() as u32;
-    player.set_blend_ticks(blend);
-    player.set_speed_cap(gesture_runtime::player::library_speed_cap(blob));
-    let mut out = Playback::default();
-    let mut pose = [0.0f32; MAX_CHANNELS];
-    let n = blob.channels();
-    for (t, p) in schedule.iter().enumerate() {
-        let entered = t > 0 && (p.segment != schedule[t - 1].segment || p.frame == 0);
-        if entered {
-            player.enter(blob, p.segment);
-        }
-        let f = player.tick(blob, &mut pose);
-        out.poses.push(pose[..n].to_vec());
-        out.shown.push((player.segment(), f));
-    }
-    out
-}
-
 /// The trace of a playback on the blob's skeleton.
 fn trace_of(
     blob: &Blob<'_>,
@@ -309,14 +181,6 @@ pub(crate) fn load_audio(model: &InferenceModel, e: &MotionEval) -> Result<Vec<i
         all.extend_from_slice(&pcm.samples[i0..i1]);
     }
     Ok(all)
-}
-
-/// The audio cut into 1 s blocks and played in a seeded shuffled order.
-pub fn shuffle_blocks(samples: &[i16], rate: u32, seed: u64) -> Vec<i16> {
-    let block = rate.max(1) as usize;
-    let mut blocks: Vec<&[i16]> = samples.chunks(block).collect();
-    blocks.shuffle(&mut ChaCha8Rng::seed_from_u64(seed));
-    blocks.concat()
 }
 
 /// The motion capture of the span as a trace (its own segmentation gives the entries).
@@ -378,25 +242,6 @@ pub const PHASE_STEP_S: f64 = 0.2;
 /// that flipped between settings).
 pub const DEFAULT_DEVICE_RUNS: u64 = 30;
 
-/// The device's motion on `samples` delayed by `delay` frames of silence, measured from where
-/// the speech starts (`frames` ticks), and its decisions.
-pub(crate) fn play_delayed(
-    blob: &Blob<'_>,
-    samples: &[i16],
-    rate: u32,
-    frames: usize,
-    delay: usize,
-    setup: impl FnOnce(&mut BlobController<'_>),
-) -> Result<(Playback, Vec<Made>), EvalError> {
-    let lead = (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize;
-    let mut input = vec![0i16; lead];
-    input.extend_from_slice(samples);
-    let (mut p, made) = play_online(blob, &input, frames + delay, setup)?;
-    p.poses.drain(..delay.min(p.poses.len()));
-    p.shown.drain(..delay.min(p.shown.len()));
-    Ok((p, made))
-}
-
 fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
     let n = ms.len().max(1) as f64;
     let avg = |f: fn(&MotionMetrics) -> f64| ms.iter().map(f).sum::<f64>() / n;
@@ -429,133 +274,6 @@ fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
         // Variety of one run (averages of counts mean little).
         ..ms.first().copied().unwrap_or_default()
     }
-}
-
-/// `f` of the normalized `spoken` histogram and `1 - f` of the normalized `paused` one;
-/// `None` when either is empty.
-pub fn mix_by_speech(spoken: &[f64], paused: &[f64], f: f64) -> Option<Vec<f64>> {
-    let (zs, zp) = (spoken.iter().sum::<f64>(), paused.iter().sum::<f64>());
-    (zs > 0.0 && zp > 0.0).then(|| {
-        spoken
-            .iter()
-            .zip(paused)
-            .map(|(s, p)| f * s / zs + (1.0 - f) * p / zp)
-            .collect()
-    })
-}
-
-/// Share of `seconds` that the syllables of `steps` cover.
-fn syllable_share(steps: &[Step], seconds: f64) -> f64 {
-    let spoken: f64 = steps
-        .iter()
-        .filter(|s| s.kind == StepKind::Syllable)
-        .map(|s| s.end_s().min(seconds) - s.start_s().min(seconds))
-        .sum();
-    (spoken / seconds.max(1e-9)).clamp(0.0, 1.0)
-}
-
-/// `m` with every translation channel held at its first frame's value: the capture as a
-/// blob's character shows it (a blob's frames hold rotations only; the character stays where
-/// it is). The hands' speeds in the capture itself include the speaker walking and swaying
-/// (the 067 take's root moves at a median 8.5 cm/s), which no played motion can show.
-pub fn translation_held(m: &Motion) -> Motion {
-    let (skeleton, frame_time, frames, mut data) = m.clone().into_parts();
-    let n = skeleton.channel_count();
-    let moves: Vec<usize> = skeleton
-        .joints
-        .iter()
-        .flat_map(|j| j.channels.iter())
-        .enumerate()
-        .filter(|(_, c)| !c.is_rotation())
-        .map(|(k, _)| k)
-        .collect();
-    if n > 0 && data.len() >= n {
-        let (first, rest) = data.split_at_mut(n);
-        for row in rest.chunks_mut(n) {
-            for &k in &moves {
-                row[k] = first[k];
-            }
-        }
-    }
-    Motion::new(skeleton, frame_time, frames, data)
-        .map(|held| held.with_source(m.source()))
-        .unwrap_or_else(|_| m.clone())
-}
-
-/// The hands' speed histogram of a capture as a blob's character shows it: the lower body
-/// held as `pack` holds a library's, then [`translation_held`]. The reference of a run
-/// against its speech's own capture (`eval-motion --mocap`, `gesture-sim metrics --mocap`).
-pub fn shown_speed_histogram(m: &Motion, effectors: &EffectorSpec) -> Result<Vec<f64>, String> {
-    let mut held = [m.clone()];
-    hold_lower_bodies(&mut held, effectors);
-    let t = Trace::from_motion(&translation_held(&held[0]), effectors, Vec::new())?;
-    Ok(speed_histogram(&t.hands, t.fps))
-}
-
-/// What the library's character does in speech like the new speech, as the reference of the
-/// hands' speeds when the speech has no capture of its own: the library's capture split
-/// into the frames spoken in syllables and those in pauses (its own speech, the WAV beside
-/// each BVH, through the blob's front-end), the two histograms weighted by the share of the
-/// new speech in syllables. People gesture while they speak and rest while they pause, so a
-/// take with long pauses is not what the same person does through a monologue. When a take
-/// has no speech beside it (a gesture library of clips), the library's whole capture.
-pub fn speech_matched_reference(
-    lib: &crate::control::library::Library,
-    config: &ProsodyConfig,
-    rate: u32,
-    steps: &[Step],
-    seconds: f64,
-    effectors: &EffectorSpec,
-) -> Vec<f64> {
-    // The takes as the blob's character shows them (pack has held the library's lower
-    // bodies already).
-    let shown: Vec<Vec<Vec<[f64; 3]>>> = lib
-        .takes
-        .iter()
-        .map(|t| {
-            Trace::from_motion(&translation_held(&t.motion), effectors, Vec::new())
-                .map(|tr| tr.hands)
-                .unwrap_or_else(|_| {
-                    let pos = &t.analysis.positions;
-                    (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect()
-                })
-        })
-        .collect();
-    let whole = || speed_histogram(&shown.concat(), lib.fps);
-    let mut spoken = vec![0.0; 26];
-    let mut paused = vec![0.0; 26];
-    for (t, hands) in lib.takes.iter().zip(&shown) {
-        let wav = t.source.with_extension("wav");
-        let Ok(pcm) = crate::audio::load_wav_at(&wav, rate) else {
-            return whole();
-        };
-        let Ok((_, own)) = crate::features::prosody_of(&pcm.samples, config) else {
-            return whole();
-        };
-        // Syllable spans in time order (steps tile the speech in order).
-        let spans: Vec<(f64, f64)> = own
-            .iter()
-            .filter(|s| s.kind == StepKind::Syllable)
-            .map(|s| (s.start_s(), s.end_s()))
-            .collect();
-        let in_syllable = |time: f64| {
-            let k = spans.partition_point(|&(a, _)| a <= time);
-            k > 0 && time < spans[k - 1].1
-        };
-        let fps = t.motion.fps();
-        // Each take weighs by its frames in syllables and in pauses.
-        let frame_steps = hands.len().saturating_sub(1);
-        let n_spoken = (0..frame_steps)
-            .filter(|&i| in_syllable((i + 1) as f64 / fps))
-            .count() as f64;
-        let hs = speed_histogram_where(hands, fps, in_syllable);
-        let hp = speed_histogram_where(hands, fps, |time| !in_syllable(time));
-        for k in 0..26 {
-            spoken[k] += n_spoken * hs[k];
-            paused[k] += (frame_steps as f64 - n_spoken) * hp[k];
-        }
-    }
-    mix_by_speech(&spoken, &paused, syllable_share(steps, seconds)).unwrap_or_else(whole)
 }
 
 /// Evaluates `model` on `e` (see the module docs).
@@ -718,119 +436,6 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::corpus::{load_corpus, LoadOptions};
-    use crate::inference::train::{fit, sequences, FitConfig};
-    use crate::synth::{write_corpus, SynthParams};
-    use gesture_runtime::prosody::Step;
-
-    #[test]
-    fn a_capture_as_shown_keeps_its_rotations_and_drops_its_walk() {
-        // A root walking 3 units per frame along X and turning 10 degrees per frame about Y,
-        // with an arm of length 2 along X: in the capture the hand moves by the walk plus
-        // the turn; held, only by the turn (a chord of 2 sin(5 deg) * 2 per frame).
-        let text = "HIERARCHY\nROOT Hips\n{\n\tOFFSET 0 0 0\n\tCHANNELS 6 Xposition Yposition \
-                    Zposition Zrotation Yrotation Xrotation\n\tJOINT RightHand\n\t{\n\t\t\
-                    OFFSET 2 0 0\n\t\tCHANNELS 3 Zrotation Xrotation Yrotation\n\t\tEnd Site\n\
-                    \t\t{\n\t\t\tOFFSET 0 0 0\n\t\t}\n\t}\n}\nMOTION\nFrames: 3\n\
-                    Frame Time: 0.1\n0 5 0 0 0 0 0 0 0\n3 5 0 0 10 0 0 0 0\n6 5 0 0 20 0 0 0 0\n";
-        let m = crate::motion::parse_bvh(text, "walk.bvh").unwrap();
-        let held = translation_held(&m);
-        assert_eq!(held.source(), "walk.bvh");
-        for f in 0..3 {
-            let (a, b) = (m.frame(f).unwrap(), held.frame(f).unwrap());
-            // Translations are the first frame's; rotations untouched.
-            assert_eq!(&b[..3], &[0.0, 5.0, 0.0]);
-            assert_eq!(&b[3..], &a[3..]);
-        }
-        let hand = |mo: &Motion, f: usize| {
-            let p = crate::motion::FkPlan::new(mo.skeleton(), &[crate::motion::Target::Joint(1)])
-                .unwrap()
-                .positions(mo)
-                .unwrap();
-            p.frame(f)[0]
-        };
-        let step = |mo: &Motion| {
-            let (p, q) = (hand(mo, 1), hand(mo, 2));
-            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
-        };
-        let chord = 2.0 * 2.0 * (5.0f64.to_radians()).sin();
-        assert!((step(&held) - chord).abs() < 1e-9, "{}", step(&held));
-        assert!(step(&m) > 2.5, "the walk is in the capture: {}", step(&m));
-    }
-
-    #[test]
-    fn the_speech_matched_reference_weighs_speech_and_pauses_as_the_new_speech_has_them() {
-        // Hands still in the capture's pauses (bin 0) and at 55 units/s in its syllables
-        // (bin 5), in any proportion: new speech spoken 70 % of its time gets 0.7 in bin 5.
-        let mut spoken = vec![0.0; 26];
-        let mut paused = vec![0.0; 26];
-        spoken[5] = 300.0;
-        paused[0] = 900.0;
-        let r = mix_by_speech(&spoken, &paused, 0.7).unwrap();
-        assert!((r[5] - 0.7).abs() < 1e-12 && (r[0] - 0.3).abs() < 1e-12);
-        assert!((r.iter().sum::<f64>() - 1.0).abs() < 1e-12);
-        // A capture without pauses (or without speech) cannot be split.
-        assert_eq!(mix_by_speech(&spoken, &[0.0; 26], 0.7), None);
-        // Syllables of 0.5 s and 1 s and a pause step of 0.5 s in 4 s of speech: 3/8 spoken.
-        let step = |kind, a: u32, b: u32| Step {
-            kind,
-            start_frame: a,
-            end_frame: b,
-            f0_hz: None,
-            intensity_db: 60.0,
-        };
-        let steps = [
-            step(StepKind::Syllable, 0, 50),
-            step(StepKind::Pause, 50, 100),
-            step(StepKind::Syllable, 100, 200),
-        ];
-        assert!((syllable_share(&steps, 4.0) - 0.375).abs() < 1e-12);
-        // Past the end of the audio nothing counts: 0.5 s + 0.5 s of 1.5 s.
-        assert!((syllable_share(&steps, 1.5) - 2.0 / 3.0).abs() < 1e-12);
-    }
-
-    /// A delayed device run is the undelayed run of the longer input with the lead cut off:
-    /// on silence (nothing for the controller to hear) delaying by `d` frames shows, at every
-    /// tick, what a run `d` frames longer shows `d` ticks later; and it always has `frames`
-    /// ticks.
-    #[test]
-    fn a_delayed_run_is_the_longer_run_without_its_lead() {
-        let dir = tempfile::tempdir().unwrap();
-        let params = SynthParams {
-            minutes: 0.5,
-            seed: 5,
-            take_seconds: 30.0,
-        };
-        write_corpus(&params, dir.path(), |_, _| {}).unwrap();
-        let c = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
-        let (seqs, segs) = sequences(&c, None);
-        let cfg = FitConfig {
-            states: Some(2),
-            clusters: Some(2),
-            restarts: 1,
-            l2: Some(1e-2),
-            ..FitConfig::default()
-        };
-        let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
-        let packed =
-            pack_model(&model, &[dir.path().to_path_buf()], &PackOptions::default()).unwrap();
-        let blob = Blob::parse(&packed.bytes).unwrap();
-        let rate = model.sample_rate_hz;
-        let fps = blob.fps() as f64;
-        let frames = (3.0 * fps) as usize;
-        let silence = vec![0i16; 3 * rate as usize];
-        let d = 7;
-        let (delayed, _) = play_delayed(&blob, &silence, rate, frames, d, |_| {}).unwrap();
-        assert_eq!(delayed.poses.len(), frames);
-        let lead = (d as f64 * rate as f64 / fps).round() as usize;
-        let longer = vec![0i16; lead + silence.len()];
-        let (whole, _) = play_online(&blob, &longer, frames + d, |_| {}).unwrap();
-        assert_eq!(delayed.poses[..], whole.poses[d..]);
-        assert_eq!(delayed.shown[..], whole.shown[d..]);
-        // No delay: the plain run.
-        let (plain, _) = play_delayed(&blob, &silence, rate, frames, 0, |_| {}).unwrap();
-        assert_eq!(plain.poses[..], whole.poses[..frames]);
-    }
 
     /// Device runs and random runs are averaged figure by figure (the speech coupling
     /// included), the largest jump is the largest of any run, and the variety figures are the

@@ -18,7 +18,9 @@
 use gesture_runtime::blob::Blob;
 use serde::Serialize;
 
-use super::motion::{load_audio, play_delayed, EvalError, MotionEval, PHASE_STEP_S};
+use super::error::EvalError;
+use super::motion::{load_audio, MotionEval, PHASE_STEP_S};
+use super::playback::play_delayed;
 use crate::control::style::parse_weights;
 use crate::inference::model::InferenceModel;
 use crate::motion::{analyze, SegmentParams};

@@ -11,12 +11,11 @@
 //!
 //! **Hand speed** ([`relative_hand_speed`]): per frame, the mean over the hands of the speed
 //! of the hand relative to the *anchor*, the effectors' nearest common ancestor joint
-//! ([`anchor_joint`]: the chest on the shared skeletons), so that a body swaying or walking
-//! does not count as gesturing; smoothed over about 1/6 s as
-//! [`crate::evaluate::metrics::smoothed_hand_speed`] does. Without an anchor (fewer than two
-//! effectors, or a trace built without one) the hands' world positions. Speed sample `i`
-//! (frame `i` to `i + 1`) is at time `(i + 1) / fps`, and falls in the audio frame holding
-//! that time.
+//! ([`anchor_joint`](super::trace::anchor_joint): the chest on the shared skeletons), so that
+//! a body swaying or walking does not count as gesturing; smoothed over about 1/6 s as
+//! [`smoothed_hand_speed`] does. Without an anchor (fewer than two effectors, or a trace built
+//! without one) the hands' world positions. Speed sample `i` (frame `i` to `i + 1`) is at time
+//! `(i + 1) / fps`, and falls in the audio frame holding that time.
 //!
 //! The figures ([`figures`]; all `None` when the speech has no pause of 1.5 s, no active
 //! frame or no loudness track, or the trace has no speed sample in a pause or in speech):
@@ -41,9 +40,9 @@
 //! the voice stops and moves again soon after it returns; a motion that ignores the voice
 //! has a ratio near 1 and long settle and react times.
 
-use crate::evaluate::metrics::{smoothed_hand_speed, Trace};
-use crate::motion::fk::{Target, Vec3};
-use crate::motion::Skeleton;
+use super::signals::{quantile, smoothed_hand_speed};
+use super::trace::Trace;
+use crate::motion::fk::Vec3;
 
 /// Length of a loudness frame (s).
 pub const FRAME_S: f64 = 0.01;
@@ -63,6 +62,44 @@ pub const SETTLE_SHARE: f64 = 0.25;
 /// `react_s` waits for the speed to reach this share of the way from the pause level to the
 /// speech level.
 pub const REACT_SHARE: f64 = 0.5;
+
+/// The speech a trace was played to, as the figures need it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Speech {
+    /// Syllable onsets (s from the trace's start).
+    pub onsets: Vec<f64>,
+    /// Steps (syllables and pauses): start (s), end (s), mean intensity (dB).
+    pub spans: Vec<(f64, f64, f64)>,
+    /// Per 10 ms audio frame from the trace's start, whether the voice is active
+    /// ([`activity`]); empty without the audio (the voice figures are
+    /// then `None`).
+    pub active: Vec<bool>,
+}
+
+impl Speech {
+    /// From the front end's steps.
+    pub fn from_steps(steps: &[gesture_runtime::prosody::Step]) -> Self {
+        use gesture_runtime::prosody::StepKind;
+        Self {
+            onsets: steps
+                .iter()
+                .filter(|s| s.kind == StepKind::Syllable)
+                .map(|s| s.start_s())
+                .collect(),
+            spans: steps
+                .iter()
+                .map(|s| (s.start_s(), s.end_s(), s.intensity_db as f64))
+                .collect(),
+            active: Vec::new(),
+        }
+    }
+
+    /// With the voice activity of `samples` (at `rate` Hz, starting where the trace starts).
+    pub fn with_audio(mut self, samples: &[i16], rate: u32) -> Self {
+        self.active = activity(samples, rate);
+        self
+    }
+}
 
 /// The four figures (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -92,9 +129,9 @@ pub fn median(v: &[f64]) -> Option<f64> {
     })
 }
 
-/// The 99th percentile by nearest rank (as [`crate::evaluate::metrics::quantile`]).
+/// The 99th percentile by nearest rank (as [`quantile`]).
 fn p99(v: &[f64]) -> f64 {
-    crate::evaluate::metrics::quantile(v, 0.99)
+    quantile(v, 0.99)
 }
 
 /// Samples per loudness frame at `rate` Hz.
@@ -157,36 +194,6 @@ pub fn pauses(active: &[bool]) -> Vec<(f64, f64)> {
         .into_iter()
         .map(|(a, b)| (a as f64 * FRAME_S, b as f64 * FRAME_S))
         .collect()
-}
-
-/// The nearest common ancestor joint of `targets`: the deepest joint that is a proper
-/// ancestor of every target joint (an end site's own joint counts as its ancestor). `None`
-/// for fewer than two targets or targets in different trees.
-pub fn anchor_joint(skeleton: &Skeleton, targets: &[Target]) -> Option<usize> {
-    if targets.len() < 2 {
-        return None;
-    }
-    let chain = |t: &Target| -> Vec<usize> {
-        let mut out = Vec::new();
-        let mut cur = match *t {
-            Target::Joint(j) => skeleton.joints.get(j).and_then(|x| x.parent),
-            Target::EndSite(j) => Some(j),
-        };
-        while let Some(j) = cur {
-            // Bounded even if a hand-built skeleton had a cycle.
-            if j >= skeleton.joints.len() || out.len() > skeleton.joints.len() {
-                break;
-            }
-            out.push(j);
-            cur = skeleton.joints[j].parent;
-        }
-        out
-    };
-    let chains: Vec<Vec<usize>> = targets.iter().map(chain).collect();
-    chains[0]
-        .iter()
-        .copied()
-        .find(|j| chains[1..].iter().all(|c| c.contains(j)))
 }
 
 /// The trace's hand speed relative to its anchor (see the module docs), smoothed: sample `i`
@@ -288,7 +295,6 @@ pub fn measure_voice(t: &Trace, active: &[bool]) -> VoiceFigures {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::evaluate::metrics::{measure, Speech};
 
     const RATE: u32 = 16_000;
 
@@ -394,7 +400,7 @@ mod tests {
         let speech = Speech::default().with_audio(&samples, RATE);
         let speed = |t: f64| if (2.0..4.0).contains(&t) { 5.0 } else { 50.0 };
         let t = trace(30.0, 6.0, speed, walking);
-        let m = measure(&t, &speech, None, None);
+        let m = measure_voice(&t, &speech.active);
         let ratio = m.pause_ratio.unwrap();
         assert!((ratio - 0.1).abs() < 0.02, "{ratio}");
         let s = m.speech_speed.unwrap();
@@ -402,7 +408,7 @@ mod tests {
         // In the world the walk dominates.
         let mut world = t.clone();
         world.anchor.clear();
-        assert!(measure(&world, &speech, None, None).speech_speed.unwrap() > 90.0);
+        assert!(measure_voice(&world, &speech.active).speech_speed.unwrap() > 90.0);
     }
 
     #[test]
@@ -493,43 +499,6 @@ mod tests {
     }
 
     #[test]
-    fn the_anchor_is_the_nearest_common_ancestor() {
-        use crate::motion::Joint;
-        let names = [
-            ("Hips", None),
-            ("Spine", Some(0)),
-            ("Chest", Some(1)),
-            ("LeftArm", Some(2)),
-            ("LeftHand", Some(3)),
-            ("RightArm", Some(2)),
-            ("RightHand", Some(5)),
-            ("Neck", Some(2)),
-            ("Head", Some(7)),
-            ("Prop", None),
-        ];
-        let sk = Skeleton {
-            joints: names
-                .iter()
-                .map(|&(n, parent)| Joint {
-                    name: n.into(),
-                    parent,
-                    offset: [0.0; 3],
-                    channels: vec![],
-                    end_site: None,
-                })
-                .collect(),
-        };
-        let j = Target::Joint;
-        assert_eq!(anchor_joint(&sk, &[j(4), j(6)]), Some(2));
-        assert_eq!(anchor_joint(&sk, &[j(4), j(6), j(8)]), Some(2));
-        assert_eq!(anchor_joint(&sk, &[j(4), j(3)]), Some(2));
-        assert_eq!(anchor_joint(&sk, &[Target::EndSite(4), j(4)]), Some(3));
-        assert_eq!(anchor_joint(&sk, &[Target::EndSite(4), j(6)]), Some(2));
-        assert_eq!(anchor_joint(&sk, &[j(4)]), None);
-        assert_eq!(anchor_joint(&sk, &[j(4), j(9)]), None);
-    }
-
-    #[test]
     fn without_a_pause_or_audio_there_are_no_voice_figures() {
         let t = trace(30.0, 6.0, |t| 10.0 + t, walking);
         // All speech, a 1 s gap, no track at all.
@@ -539,7 +508,7 @@ mod tests {
             RATE,
         );
         for speech in [loud, gap, Speech::default()] {
-            let m = measure(&t, &speech, None, None);
+            let m = measure_voice(&t, &speech.active);
             assert_eq!(
                 (m.pause_ratio, m.settle_s, m.react_s, m.speech_speed),
                 (None, None, None, None)

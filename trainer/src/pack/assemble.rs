@@ -15,7 +15,7 @@ use super::{PackError, PackOptions};
 use crate::control::build::ControlModel;
 use crate::control::semantic::{LabelParams, Labelling};
 use crate::control::Library;
-use crate::evaluate::metrics::{quantile, smoothed_hand_speed, speed_minima};
+use crate::evaluate::signals::{quantile, smoothed_hand_speed, speed_minima};
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::inference_section;
 use crate::motion::Skeleton;

@@ -20,7 +20,7 @@
 
 use gesture_runtime::rotation::{euler_angles, mat_mul, transpose, Mat3};
 
-use crate::evaluate::metrics::feet;
+use crate::evaluate::trace::feet;
 use crate::motion::fk::local_transform;
 use crate::motion::{Motion, Skeleton};
 
