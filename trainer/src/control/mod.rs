@@ -7,7 +7,8 @@
 //!   and the decision rule;
 //! - [`prune`]: dropping successors that are never optimal, and budget truncation;
 //! - [`dp`]: the offline dynamic-programming reference;
-//! - [`build`]: model + library to a solved, pruned policy and its regret.
+//! - [`build`]: model + library to a solved, pruned policy (the control model);
+//! - [`regret`]: what pruning and quantization cost, measured on the packed tables;
 //! - [`schedule`]: what random selection and the offline DP reference play, frame by frame;
 //! - [`style`]: tone transforms of the kinematic parameters (per-tone value tables);
 //! - [`semantic`]: semantic labels, strokes and the entries before them.
@@ -21,6 +22,7 @@ pub mod dp;
 pub mod library;
 pub mod mdp;
 pub mod prune;
+pub mod regret;
 pub mod schedule;
 pub mod semantic;
 pub mod style;

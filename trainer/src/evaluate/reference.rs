@@ -8,7 +8,7 @@ use gesture_runtime::prosody::{ProsodyConfig, Step, StepKind};
 use super::signals::{speed_histogram, speed_histogram_where};
 use super::trace::Trace;
 use crate::motion::{EffectorSpec, Motion};
-use crate::pack::hold_lower_bodies;
+use crate::pack::library::hold_lower_bodies;
 
 /// `f` of the normalized `spoken` histogram and `1 - f` of the normalized `paused` one;
 /// `None` when either is empty.
