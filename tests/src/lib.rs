@@ -11,15 +11,29 @@
 //! tools in a venv ([`ros2_python`]); they skip in the same way when it is absent, and fail
 //! instead when [`REQUIRE_ROS2_ENV`] is set (CI sets it after installing the venv).
 //!
+//! **The skips are counted.** A passing test's output is captured by the test harness, so a
+//! skip's note alone would never be seen. Every skip is therefore also written to a ledger
+//! shared by the test binaries of one `cargo test` run (under the target folder, keyed by the
+//! `cargo` process that runs them all), and the last test binary a plain workspace
+//! `cargo test` runs (`host-sim/tests/zz_real_data.rs`; cargo runs test binaries in the order
+//! of their package's and target's names) prints one line straight to the process's stderr,
+//! which the harness does not capture: `real data: 23 tests skipped: ../shared/data is absent
+//! (...)`. [`SHARED_DATA_ENV`] points the tests at another folder (a missing one to see the
+//! skips).
+//!
 //! Dependency-free on purpose, so the runtime's, the trainer's and the simulator's tests can
 //! all use it as a dev-dependency.
 
 pub mod docs;
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Set (to anything) to turn every real-data skip into a failure.
 pub const REQUIRE_DATA_ENV: &str = "GESTURE_REQUIRE_DATA";
+
+/// Set to a folder to use it instead of `../shared/data`.
+pub const SHARED_DATA_ENV: &str = "GESTURE_SHARED_DATA";
 
 /// The repository's root (this crate sits in `tests/`).
 pub fn repo_root() -> PathBuf {
@@ -28,15 +42,24 @@ pub fn repo_root() -> PathBuf {
         .map_or_else(|| PathBuf::from(".."), Path::to_path_buf)
 }
 
-/// `../shared/data` relative to the repository root, whether or not it exists.
+/// `../shared/data` relative to the repository root (or [`SHARED_DATA_ENV`]), whether or not
+/// it exists.
 pub fn shared_data_dir() -> PathBuf {
-    repo_root().join("../shared/data")
+    match std::env::var_os(SHARED_DATA_ENV) {
+        Some(dir) => PathBuf::from(dir),
+        None => repo_root().join("../shared/data"),
+    }
 }
 
 /// `../shared/data/<sub>` if it exists (`sub` may be empty for the folder itself). Otherwise
 /// prints `skipping <test>: <why>` on stderr and returns `None`, or panics if
 /// [`REQUIRE_DATA_ENV`] is set.
 pub fn shared_data(test: &str, sub: &str) -> Option<PathBuf> {
+    find(test, sub, true)
+}
+
+/// [`shared_data`], its skip counted in the run's ledger when `count`.
+fn find(test: &str, sub: &str, count: bool) -> Option<PathBuf> {
     let root = shared_data_dir();
     let path = if sub.is_empty() {
         root.clone()
@@ -51,16 +74,101 @@ pub fn shared_data(test: &str, sub: &str) -> Option<PathBuf> {
     } else {
         format!("{} is absent, nothing measured", root.display())
     };
-    skip(test, &why);
+    note(test, &why, count);
     None
 }
 
-/// Reports a skipped real-data test (see [`shared_data`]); panics under [`REQUIRE_DATA_ENV`].
+/// Reports a skipped real-data test (see [`shared_data`]) and counts it in this run's ledger
+/// (see the crate docs); panics under [`REQUIRE_DATA_ENV`].
 pub fn skip(test: &str, why: &str) {
+    note(test, why, true);
+}
+
+/// [`skip`], counted in the ledger when `count`.
+fn note(test: &str, why: &str, count: bool) {
     if std::env::var_os(REQUIRE_DATA_ENV).is_some() {
         panic!("{test}: real data required ({REQUIRE_DATA_ENV} is set) but {why}");
     }
     eprintln!("skipping {test}: {why}");
+    if let Some(ledger) = ledger().filter(|_| count) {
+        // One test per line: the binary and the harness's thread (named after the test).
+        let binary = std::env::current_exe()
+            .ok()
+            .and_then(|e| e.file_stem().map(|s| s.to_string_lossy().into_owned()))
+            .unwrap_or_default();
+        let thread = std::thread::current().name().unwrap_or(test).to_string();
+        let line = format!("{binary} {thread}\t{why}\n");
+        // Best effort: a ledger that cannot be written leaves the note above.
+        let _ = std::fs::create_dir_all(ledger.parent().unwrap_or(Path::new(".")));
+        let _ = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(&ledger)
+            .and_then(|mut f| f.write_all(line.as_bytes()));
+    }
+}
+
+/// The ledger of this `cargo test` run's skips: `<target>/<profile>/real-data-skips/<run>`,
+/// the run named by the parent process (`cargo`) and its start time, so a later run that gets
+/// the same process id starts a new ledger. `None` off Unix.
+fn ledger() -> Option<PathBuf> {
+    let exe = std::env::current_exe().ok()?;
+    // target/<profile>/deps/<binary>
+    let profile = exe.parent()?.parent()?;
+    Some(profile.join("real-data-skips").join(run_key()?))
+}
+
+#[cfg(unix)]
+fn run_key() -> Option<String> {
+    let ppid = std::os::unix::process::parent_id();
+    // Field 22 of /proc/<pid>/stat, the start time: the 20th after the command's `)`.
+    let start = std::fs::read_to_string(format!("/proc/{ppid}/stat"))
+        .ok()
+        .and_then(|s| {
+            let (_, rest) = s.rsplit_once(')')?;
+            rest.split_whitespace().nth(19).map(str::to_string)
+        })
+        .unwrap_or_default();
+    Some(format!("{ppid}-{start}"))
+}
+
+#[cfg(not(unix))]
+fn run_key() -> Option<String> {
+    None
+}
+
+/// The one line about this run's skipped real-data tests (`None`: none skipped), and the
+/// ledger emptied: how many, and why (the shared folder absent, or recordings missing from
+/// it; each test's output says which).
+pub fn skipped_summary() -> Option<String> {
+    let ledger = ledger()?;
+    let text = std::fs::read_to_string(&ledger).ok()?;
+    let _ = std::fs::remove_file(&ledger);
+    let tests: std::collections::BTreeSet<&str> = text
+        .lines()
+        .filter_map(|l| l.split_once('\t').map(|(t, _)| t))
+        .collect();
+    if tests.is_empty() {
+        return None;
+    }
+    let root = shared_data_dir();
+    let why = if root.is_dir() {
+        "recordings are missing from the shared data (each test's output names them)".to_string()
+    } else {
+        format!("{} is absent", root.display())
+    };
+    Some(format!(
+        "real data: {} tests skipped: {why} (set {REQUIRE_DATA_ENV}=1 to make a skip fail)",
+        tests.len()
+    ))
+}
+
+/// Prints [`skipped_summary`] straight to the process's stderr, which the test harness does
+/// not capture (it captures `eprintln!` only).
+pub fn print_skipped_summary() {
+    if let Some(line) = skipped_summary() {
+        let _ = writeln!(std::io::stderr().lock(), "{line}");
+    }
 }
 
 /// Set (to anything) to turn every skip of a ROS 2 interoperability test into a failure (CI
@@ -131,10 +239,11 @@ mod tests {
     fn a_missing_recording_skips_with_a_reason_or_fails_when_required() {
         let name = "no-such-recording-for-the-locator-test";
         if std::env::var_os(REQUIRE_DATA_ENV).is_some() {
-            let r = std::panic::catch_unwind(|| shared_data("locator", name));
+            let r = std::panic::catch_unwind(|| find("locator", name, false));
             assert!(r.is_err(), "a required recording that is missing must fail");
         } else {
-            assert_eq!(shared_data("locator", name), None);
+            // Not counted: no real-data test skipped here.
+            assert_eq!(find("locator", name, false), None);
         }
         assert!(repo_root().join("Cargo.toml").is_file());
     }
