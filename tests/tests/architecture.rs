@@ -16,15 +16,19 @@ use std::path::{Path, PathBuf};
 /// The longest a source file may be (STYLE.md 13: past this, the concept has parts).
 const MAX_LINES: usize = 800;
 
-/// Files over [`MAX_LINES`] that are being split along their concepts in parallel work; both
-/// checks leave them out (the circles through them, `blob` <-> `controller` and `follow` <->
-/// `policy`, are untangled with the split). Each name here is a debt, not a permission, and
-/// leaves the list when its file is split.
-const BEING_SPLIT: &[&str] = &[
-    "runtime/src/controller/mod.rs",
-    "runtime/src/policy.rs",
-    "runtime/src/player.rs",
-    "runtime/src/follow.rs",
+/// Circles that came with parallel work (the controller's, policy's and player's split and
+/// the simulator's bodies) and are untangled there: each a set of files a reported circle may
+/// lie in. Each is a debt, not a permission: `blob` reads the label capacities and the
+/// decision timing from `controller`, `policy` the rest extras from `follow`, and the preview's
+/// canvas is shared with the bodies and servo bars it draws.
+const OPEN_CIRCLES: &[&[&str]] = &[
+    &[
+        "runtime/src/blob/error.rs",
+        "runtime/src/blob/mod.rs",
+        "runtime/src/controller/mod.rs",
+    ],
+    &["runtime/src/follow.rs", "runtime/src/policy/mod.rs"],
+    &["host-sim/src/run/body.rs", "host-sim/src/run/preview.rs"],
 ];
 
 /// The crates whose sources are checked, as folders under the repository root.
@@ -45,7 +49,7 @@ fn no_source_file_is_over_the_line() {
         for file in rust_files(&root.join(c).join("src")) {
             let lines = std::fs::read_to_string(&file).unwrap().lines().count();
             let rel = relative(&root, &file);
-            if lines > MAX_LINES && !BEING_SPLIT.contains(&rel.as_str()) {
+            if lines > MAX_LINES {
                 over.push(format!("{rel}: {lines} lines"));
             }
         }
@@ -61,10 +65,15 @@ fn no_two_files_import_each_other() {
     let root = e2e_tests::repo_root();
     let mut circles = Vec::new();
     for c in CRATES {
-        let mut tree = ModuleTree::read(&root.join(c).join("src"));
-        tree.leave_out(|f| BEING_SPLIT.contains(&relative(&root, f).as_str()));
+        let tree = ModuleTree::read(&root.join(c).join("src"));
         for (circle, rest) in tree.circles() {
             let names: Vec<String> = circle.iter().map(|f| relative(&root, f)).collect();
+            if OPEN_CIRCLES
+                .iter()
+                .any(|open| names.iter().all(|n| open.contains(&n.as_str())))
+            {
+                continue;
+            }
             let mut line = names.join(" -> ");
             if !rest.is_empty() {
                 let rest: Vec<String> = rest.iter().map(|f| relative(&root, f)).collect();
@@ -371,14 +380,6 @@ impl ModuleTree {
         };
         base.extend(rest.iter().filter(|s| *s != "self").cloned());
         Some(base)
-    }
-
-    /// Drops the files `out` accepts, with their imports both ways.
-    fn leave_out(&mut self, out: impl Fn(&Path) -> bool) {
-        self.edges.retain(|f, _| !out(f));
-        for to in self.edges.values_mut() {
-            to.retain(|f| !out(f));
-        }
     }
 
     /// The import circles: per strongly connected group of files, one circle through them and
