@@ -1,6 +1,6 @@
 //! What a command returns: [`CliError`] and its exit status, which library errors are the
 //! user's ([`ExitKind`]), and stdout lines that turn a closed pipe into a quiet stop
-//! ([`write_line`], through `outln!`).
+//! (`write_line`, through `outln!`).
 
 use std::path::Path;
 

@@ -21,13 +21,14 @@
 //!   percentile of the hands' displacement per frame over the whole motion;
 //! - **timing**: **beat alignment**, whether the gestures' strokes fall on syllables: each
 //!   *stroke* (a prominent peak of the mean hand speed smoothed over 1/6 s, see
-//!   [`stroke_frames`]) scores `exp(-d^2 / (2 * 0.1^2))` for the distance `d` (s) to the
+//!   [`stroke_frames`](super::signals::stroke_frames)) scores `exp(-d^2 / (2 * 0.1^2))` for the distance `d` (s) to the
 //!   nearest syllable onset (AIST++'s and EDGE's form, kernel 0.1 s), averaged over the
 //!   strokes; its **chance** level, the same strokes shifted by 0.35-1.5 s either way (so the
 //!   speech around them stays as dense), and the **lift** over it. And the **speech
 //!   coupling**: the Pearson correlation, frame by frame, between the mean hand speed
 //!   smoothed over 1/6 s and the intensity (dB) of the syllable or pause being spoken (each
-//!   step's mean intensity over its span, floored at [`COUPLING_FLOOR_DB`]).
+//!   step's mean intensity over its span, floored at
+//!   [`COUPLING_FLOOR_DB`](super::signals::COUPLING_FLOOR_DB)).
 //!
 //!   Why strokes, not pauses of the hands: on the shared ZeroEGGS captures with their own
 //!   speech, the strokes land near syllable onsets (alignment 0.80, 0.77 on the 9-joint
@@ -100,9 +101,10 @@ pub struct MotionMetrics {
     pub p99_step: f64,
     /// How close the strokes fall to syllable onsets (0-1; see the module docs).
     pub beat_alignment: f64,
-    /// Strokes ([`stroke_frames`]) per second.
+    /// Strokes ([`stroke_frames`](super::signals::stroke_frames)) per second.
     pub beats_per_s: f64,
-    /// Beat alignment of the same strokes shifted by each of [`chance_shifts`]: what
+    /// Beat alignment of the same strokes shifted by each of
+    /// [`chance_shifts`](super::signals::chance_shifts): what
     /// strokes not timed on the syllables score in speech this dense.
     pub beat_chance: f64,
     /// `beat_alignment - beat_chance`: how much better the strokes fall on the onsets than

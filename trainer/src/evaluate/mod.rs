@@ -9,7 +9,7 @@
 //! - [`motion`]: motion quality of the online controller on held-out audio against its
 //!   ablations, random selection, the offline DP reference and the motion capture;
 //! - [`playback`]: the device loop on audio and schedules through the player, as played;
-//! - [`reference`]: the hand-speed reference matched to the speech, as the character shows
+//! - [`reference`](mod@reference): the hand-speed reference matched to the speech, as the character shows
 //!   it;
 //! - [`voice`]: whether the body follows the voice: the hands' speed in the speech's pauses
 //!   against in speech, and how soon they settle and move again (part of [`metrics`]).

@@ -16,15 +16,15 @@
 //!
 //! **Everything runs the bytes `pack` writes.** The model and library are packed in memory
 //! ([`pack_model`]) and read back with `Blob::parse`; the online methods run the runtime's
-//! device loop ([`Device`]) on the audio's samples, and random and DP are played through the
-//! runtime's own [`Player`] over the blob's frames (the same inertialized cuts). Every pose is
+//! device loop ([`Device`](gesture_runtime::device::Device)) on the audio's samples, and random and DP are played through the
+//! runtime's own [`Player`](gesture_runtime::player::Player) over the blob's frames (the same inertialized cuts). Every pose is
 //! put back on the library's skeleton ([`PoseSkeleton`]) and measured there, so the figures
 //! describe what a viewer of the character sees.
 //!
 //! **The hand-speed reference.** With `--mocap`, the capture of the speech itself. Without
 //! one (another speaker's speech), [`speech_matched_reference`]: the library's capture in
 //! its syllables and in its pauses, weighed as the new speech has them. Either is taken *as
-//! the character shows it* ([`translation_held`]: the lower body held as `pack` holds it,
+//! the character shows it* ([`translation_held`](super::reference::translation_held): the lower body held as `pack` holds it,
 //! no translation): the hands of a speaker who walks or sways move faster in the world than
 //! any played motion can, since a blob holds rotations only (the 067 take's root moves at a
 //! median 8.5 cm/s; with it, its reference for beat-scott put 6.6 % of the frames below

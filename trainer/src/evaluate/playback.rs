@@ -1,5 +1,5 @@
 //! Playing a blob as the evaluations do: the runtime's device loop on audio samples
-//! ([`play_online`], [`play_delayed`]), a schedule of library frames through the runtime's
+//! (`play_online`, `play_delayed`), a schedule of library frames through the runtime's
 //! player ([`play_schedule`]), and the audio shuffled in blocks for the ablation
 //! ([`shuffle_blocks`]). What was shown comes back as a [`Playback`].
 

@@ -126,7 +126,7 @@ pub fn correlation(x: &[f64], y: &[f64]) -> f64 {
     c / (vx * vy).sqrt()
 }
 
-/// [`MotionMetrics::speech_coupling`]: the correlation of the smoothed hand speed (frame `i`
+/// [`MotionMetrics::speech_coupling`](super::metrics::MotionMetrics::speech_coupling): the correlation of the smoothed hand speed (frame `i`
 /// to `i + 1`, at time `(i + 1) / fps`) with the intensity of the step spoken then; frames
 /// outside every step are left out.
 pub fn speech_coupling(hands: &[Vec<Vec3>], fps: f64, spans: &[(f64, f64, f64)]) -> f64 {
@@ -170,7 +170,7 @@ pub const STROKE_GAP_S: f64 = 1.0 / 6.0;
 pub const STROKE_WINDOW_S: f64 = 2.0;
 /// Width (s) of the beat-alignment kernel (AIST++ and EDGE use 3 frames at 30 fps).
 pub const BEAT_SIGMA_S: f64 = 0.1;
-/// The shifts (s) of the strokes behind [`MotionMetrics::beat_chance`]: 12 each way, from
+/// The shifts (s) of the strokes behind [`MotionMetrics::beat_chance`](super::metrics::MotionMetrics::beat_chance): 12 each way, from
 /// 0.35 s (farther than the kernel reaches) to 1.5 s (near enough that the speech is as dense).
 pub fn chance_shifts() -> impl Iterator<Item = f64> {
     (0..12).flat_map(|k| {

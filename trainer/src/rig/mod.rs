@@ -81,9 +81,9 @@
 //!
 //! ## Invariants
 //!
-//! A [`Rig`] from [`Rig::parse`] or [`Rig::full_skeleton`] has 1..=[`MAX_CHANNELS`] channels
+//! A [`Rig`] from [`Rig::parse`] or [`Rig::full_skeleton`] has 1..=[`MAX_CHANNELS`](gesture_runtime::rig::MAX_CHANNELS) channels
 //! with distinct names, at least one joint alias each, calibrations that pass
-//! [`ChannelCal::validate`] and a period that passes
+//! [`ChannelCal::validate`](gesture_runtime::rig::ChannelCal::validate) and a period that passes
 //! [`gesture_runtime::rig::validate_period`], so a runtime `ServoRig` built from it cannot
 //! refuse it. A [`BoundRig`] holds joint indices valid for the skeleton it was bound to;
 //! [`BoundRig::channel_values`] gives `None` rather than panicking for another skeleton or a

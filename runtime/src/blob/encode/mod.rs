@@ -5,7 +5,7 @@
 //! bug, reported as [`EncodeError::Invalid`] with the reader's typed error).
 //!
 //! The owned sections borrow into the same wire structs the reader decodes
-//! ([`OwnedPayload::payload`]), and every table is quantized by [`Quantization`], so the
+//! ([`OwnedPayload::payload`]), and every table is quantized by [`Quantization`](crate::blob::Quantization), so the
 //! writer and the reader share one definition of every byte.
 //!
 //! - `error`: [`EncodeError`] and the integer-fit checks;

@@ -103,7 +103,7 @@ impl OwnedLibrary {
 
     /// The same library with each segment's energy (the log of its hands' mean speed over the
     /// library's median frame speed; 0 for all by default, a missing one 0) quantized to an
-    /// `i8` in steps of 1/[`ENERGY_SCALE`](super::ENERGY_SCALE), saturating.
+    /// `i8` in steps of 1/[`ENERGY_SCALE`](crate::blob::ENERGY_SCALE), saturating.
     pub fn with_energy(mut self, energy: &[f32]) -> Self {
         for (q, &e) in self.energy.iter_mut().zip(energy) {
             let v = if e.is_finite() { e * ENERGY_SCALE } else { 0.0 };
@@ -116,7 +116,7 @@ impl OwnedLibrary {
     /// `channels`) per channel over its range ([`quantize_range`]: error at most half a step,
     /// range / 65534), and lays out `segments`, the motion `beats` (frame indices) and the
     /// rotation `groups` (first channel, Euler order as an
-    /// [`EULER_ORDERS`](super::EULER_ORDERS) index).
+    /// [`EULER_ORDERS`](crate::blob::EULER_ORDERS) index).
     pub fn new(
         fps: f64,
         channels: usize,

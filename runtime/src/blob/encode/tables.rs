@@ -221,7 +221,7 @@ impl OwnedPolicy {
     }
 
     /// Quantizes and lays out the policy tables (checks that every number fits its field;
-    /// the rules of the format are checked by [`encode`]).
+    /// the rules of the format are checked by [`encode`](super::encode)).
     pub fn new(p: &PolicyInput<'_>) -> Result<Self, EncodeError> {
         if p.successors.len() != p.exits.len() {
             return inconsistent(alloc::format!(
@@ -285,7 +285,7 @@ impl OwnedStyles {
     /// The section for tones named `names`, tone `m` having `u[m]` (segments x S,
     /// segment-major) and `u_cont[m]` (exit points x S; any value at end exits). The tables are
     /// quantized together, one scale for all tones, so a mix of tones is the mix of their
-    /// stored codes. Names must not contain `'\n'`; the other rules are checked by [`encode`].
+    /// stored codes. Names must not contain `'\n'`; the other rules are checked by [`encode`](super::encode).
     pub fn new(names: &[&str], u: &[Vec<f64>], u_cont: &[Vec<f64>]) -> Result<Self, EncodeError> {
         if u.len() != names.len() || u_cont.len() != names.len() {
             return inconsistent(alloc::format!(
@@ -363,7 +363,7 @@ pub struct OwnedLabels {
 
 impl OwnedLabels {
     /// Quantizes and lays out the labels section (the format's rules are checked by
-    /// [`encode`]).
+    /// [`encode`](super::encode)).
     pub fn new(p: &LabelsInput<'_>) -> Result<Self, EncodeError> {
         let l = p.names.len();
         if p.u.len() != l || p.u_cont.len() != l {
