@@ -169,6 +169,9 @@ pub enum RunError {
     /// The summary could not be written.
     #[error("writing output: {0}")]
     Summary(#[from] std::io::Error),
+    /// `--ros2` or `--mcap` could not start, be made or be sent.
+    #[error(transparent)]
+    Ros2(#[from] crate::ros2::Ros2Error),
 }
 
 impl From<RigError> for RunError {
@@ -193,6 +196,7 @@ impl RunError {
             Self::Sim(_) | Self::Render { .. } | Self::Write { .. } | Self::Summary(_) => 1,
             Self::Vmc(crate::vmc::VmcError::Send(_)) => 1,
             Self::Vmc(_) => 2,
+            Self::Ros2(e) => e.exit_code(),
         }
     }
 }
@@ -663,7 +667,7 @@ fn stream_out(
     realtime: bool,
     mut vmc: Option<&mut crate::vmc::VmcSender>,
     mut ros: Option<(&mut crate::ros2::Publisher, &crate::ros2::JointStream)>,
-) -> Result<(), crate::error::SimError> {
+) -> Result<(), RunError> {
     let start = Instant::now();
     if let Some((p, _)) = &mut ros {
         p.set_origin_ns(crate::ros2::unix_nanos());
