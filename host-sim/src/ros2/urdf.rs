@@ -49,7 +49,6 @@ use gesture_trainer::motion::fk::local_transform;
 use gesture_trainer::rig::PoseSkeleton;
 
 use super::Ros2Error;
-use crate::error::SimError;
 use crate::run::{calibrations, read_blob, RunError};
 
 /// Metres per BVH unit (BVH units taken as centimetres).
@@ -607,7 +606,7 @@ pub fn run(
     rig: Option<&Path>,
     file: Option<&Path>,
     out: &mut impl std::io::Write,
-) -> Result<(), SimError> {
+) -> Result<(), RunError> {
     if let Some(f) = file {
         let mut inputs = vec![blob_path];
         inputs.extend(rig);
