@@ -96,10 +96,9 @@ pub fn rest_rate(energy: f32) -> f32 {
 /// The calmest segments, candidates at every exit point while resting.
 pub const REST_SET: usize = 6;
 
-/// The calmest of those, candidates at every exit point while resting (each candidate costs a
-/// dot product per value table mixed: six under a three-tone style took the worst decision
-/// past 50 k instructions on a Cortex-M4F).
-pub const REST_EXTRAS: usize = 3;
+/// The calmest of those, candidates at every exit point while resting: the selector's own
+/// bound ([`crate::policy::REST_EXTRAS`]).
+pub use crate::policy::REST_EXTRAS;
 
 /// Voice level (the step feature, 10 dB units) at which the energy weight is full.
 pub const VOICE_SPAN: f32 = 0.5;

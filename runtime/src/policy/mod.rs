@@ -50,7 +50,10 @@ pub use tables::PolicyTables;
 
 use heapless::HistoryBuffer;
 
-use crate::follow::REST_EXTRAS;
+/// Most rest segments ([`crate::follow::RestSet`]) a decision adds as candidates while
+/// resting (each candidate costs a dot product per value table mixed: six under a three-tone
+/// style took the worst decision past 50 k instructions on a Cortex-M4F).
+pub const REST_EXTRAS: usize = 3;
 
 /// What to do at an exit point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
