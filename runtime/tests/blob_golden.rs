@@ -206,10 +206,13 @@ fn golden_bytes_and_round_trip() {
         })
     );
     assert_eq!(sk.drive(1), None);
-    for code in 0..8u8 {
+    // 0..=7: twist, channel and the six Euler orders; 8..=16: the body measures.
+    for code in 0..17u8 {
         assert_eq!(DriveMode::from_code(code).map(DriveMode::code), Some(code));
     }
-    assert_eq!(DriveMode::from_code(8), None);
+    assert_eq!(DriveMode::from_code(8), Some(DriveMode::Body(0)));
+    assert_eq!(DriveMode::from_code(17), None);
+    assert_eq!(DriveMode::Body(9).code(), 0xFF);
     // Without the section: one byte (postcard's None), and no skeleton.
     let mut bare = Tiny::new();
     bare.skeleton = None;

@@ -73,5 +73,5 @@ pub use payload::{
 };
 pub use quantize::{quantize_range, quantize_symmetric, Quantization, QUANT_MAX};
 pub use records::{calibration_from_record, calibration_record, gmm_from_record, gmm_record};
-pub use skeleton::{BvhChannel, Drive, DriveMode, SkeletonView, EULER_ORDERS};
+pub use skeleton::{BvhChannel, Drive, DriveMode, SkeletonView, BODY_MEASURES, EULER_ORDERS};
 pub use view::{Blob, ExitPoint, GmmComponents, SectionSizes, SegmentInfo, Successor, Successors};

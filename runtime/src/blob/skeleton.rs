@@ -95,6 +95,21 @@ pub const EULER_ORDERS: [[u8; 3]; 6] = [
     [2, 1, 0],
 ];
 
+/// Body measures of drive modes 8..=16 (the trainer's rig key `body`), in code order: mode
+/// `8 + k` is `BODY_MEASURES[k]`. Their definitions (angles of world-space bone directions in
+/// the chest's body frame) are in docs/blob-format.md, 3.7.
+pub const BODY_MEASURES: [&str; 9] = [
+    "head_pan",
+    "head_tilt",
+    "head_roll",
+    "left_arm_raise",
+    "left_arm_swing",
+    "right_arm_raise",
+    "right_arm_swing",
+    "left_elbow_flex",
+    "right_elbow_flex",
+];
+
 /// How a rig channel's angle was read from its joint (the trainer's rig `mode`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DriveMode {
@@ -105,6 +120,10 @@ pub enum DriveMode {
     /// The angle for the axis in the Euler decomposition with this order (codes 2..=7,
     /// [`EULER_ORDERS`]).
     Euler([u8; 3]),
+    /// A body measure, [`BODY_MEASURES`]`[k]` (codes 8..=16): `joint` is the bone that moves
+    /// (head, upper arm or forearm), `chain_top` the chest whose frame is the reference;
+    /// `axis` is unused (0).
+    Body(u8),
 }
 
 impl DriveMode {
@@ -113,13 +132,18 @@ impl DriveMode {
         match code {
             0 => Some(Self::Twist),
             1 => Some(Self::Channel),
-            c => EULER_ORDERS
-                .get(usize::from(c).checked_sub(2)?)
+            2..=7 => EULER_ORDERS
+                .get(usize::from(code) - 2)
                 .map(|&o| Self::Euler(o)),
+            c => {
+                let k = c.checked_sub(8)?;
+                (usize::from(k) < BODY_MEASURES.len()).then_some(Self::Body(k))
+            }
         }
     }
 
-    /// The code of a mode (`Euler` with an order not in [`EULER_ORDERS`] gives 0xFF).
+    /// The code of a mode (`Euler` with an order not in [`EULER_ORDERS`], or `Body` past
+    /// [`BODY_MEASURES`], gives 0xFF).
     pub fn code(self) -> u8 {
         match self {
             Self::Twist => 0,
@@ -128,6 +152,8 @@ impl DriveMode {
                 .iter()
                 .position(|&x| x == o)
                 .map_or(0xFF, |i| i as u8 + 2),
+            Self::Body(k) if usize::from(k) < BODY_MEASURES.len() => 8 + k,
+            Self::Body(_) => 0xFF,
         }
     }
 }
