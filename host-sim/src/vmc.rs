@@ -12,9 +12,11 @@
 //! `(-x, y, z) * scale` (`scale` 0.01 by default) and a rotation quaternion `(x, y, z, w)` as
 //! `(x, -y, -z, w)`: the same mirror through the YZ plane applied to both.
 //!
-//! **Bones.** Library joints map to humanoid bones by name aliases (the first alias the
-//! skeleton has wins; names compare without case), which cover the ZeroEGGS skeletons (75 and 9
-//! joints), the Bandai-Namco skeleton and the synthetic character; a bone-map file
+//! **Bones.** Library joints map to humanoid bones by name aliases
+//! ([`gesture_trainer::motion::humanoid`], shared with the rig's body channels: the first alias
+//! the skeleton has wins; names compare without case, punctuation or a `prefix:`), which cover
+//! the ZeroEGGS skeletons (75 and 9 joints), the Bandai-Namco, CMU and ReActIdle skeletons and
+//! the synthetic character; a bone-map file
 //! (`Humanoid = "joint"` lines, TOML) overrides or adds any. A joint that maps to no bone is not
 //! lost: its rotation is folded into the nearest mapped descendant, so a bone's rotation is the
 //! product of the local rotations from just below its mapped ancestor down to its own joint
@@ -29,48 +31,12 @@ use rosc::{OscBundle, OscMessage, OscPacket, OscTime, OscType};
 
 use gesture_runtime::rotation::{normalize, quat_mul, quaternion, Mat3, Quat};
 use gesture_trainer::motion::fk::local_transform;
+use gesture_trainer::motion::humanoid::find_bones;
 use gesture_trainer::rig::PoseSkeleton;
 
-/// Humanoid bones and the joint names that map to them, in order of preference.
-pub const BONE_ALIASES: [(&str, &[&str]); 22] = [
-    ("Hips", &["Hips", "Pelvis"]),
-    ("Spine", &["Spine"]),
-    ("Chest", &["Chest", "Spine2", "Spine1"]),
-    ("UpperChest", &["UpperChest", "Spine3"]),
-    ("Neck", &["Neck"]),
-    ("Head", &["Head"]),
-    ("LeftShoulder", &["LeftShoulder", "Shoulder_L"]),
-    ("LeftUpperArm", &["LeftUpperArm", "LeftArm", "UpperArm_L"]),
-    (
-        "LeftLowerArm",
-        &["LeftLowerArm", "LeftForeArm", "LowerArm_L"],
-    ),
-    ("LeftHand", &["LeftHand", "Hand_L"]),
-    ("RightShoulder", &["RightShoulder", "Shoulder_R"]),
-    (
-        "RightUpperArm",
-        &["RightUpperArm", "RightArm", "UpperArm_R"],
-    ),
-    (
-        "RightLowerArm",
-        &["RightLowerArm", "RightForeArm", "LowerArm_R"],
-    ),
-    ("RightHand", &["RightHand", "Hand_R"]),
-    ("LeftUpperLeg", &["LeftUpperLeg", "LeftUpLeg", "UpperLeg_L"]),
-    ("LeftLowerLeg", &["LeftLowerLeg", "LeftLeg", "LowerLeg_L"]),
-    ("LeftFoot", &["LeftFoot", "Foot_L"]),
-    ("LeftToes", &["LeftToes", "LeftToeBase", "Toes_L"]),
-    (
-        "RightUpperLeg",
-        &["RightUpperLeg", "RightUpLeg", "UpperLeg_R"],
-    ),
-    (
-        "RightLowerLeg",
-        &["RightLowerLeg", "RightLeg", "LowerLeg_R"],
-    ),
-    ("RightFoot", &["RightFoot", "Foot_R"]),
-    ("RightToes", &["RightToes", "RightToeBase", "Toes_R"]),
-];
+/// Humanoid bones and the joint names that map to them (the trainer's, shared with the rig's
+/// body channels).
+pub use gesture_trainer::motion::humanoid::BONE_ALIASES;
 
 /// Why VMC output could not start.
 #[derive(Debug, thiserror::Error)]
@@ -117,10 +83,8 @@ impl BoneMap {
     pub fn new(sk: &PoseSkeleton, file: Option<&Path>) -> Result<Self, VmcError> {
         let skeleton = sk.skeleton();
         let mut map: BTreeMap<String, usize> = BTreeMap::new();
-        for (bone, aliases) in BONE_ALIASES {
-            if let Some(j) = aliases.iter().find_map(|a| skeleton.find_ignore_case(a)) {
-                map.insert(bone.to_string(), j);
-            }
+        for (bone, j) in find_bones(skeleton) {
+            map.insert(bone.to_string(), j);
         }
         if let Some(path) = file {
             let bad = |reason: String| VmcError::BoneMap {

@@ -72,8 +72,12 @@ pub struct Transform {
 
 /// World transforms of every joint at frame `f` (`None` if `f` is out of range).
 pub fn world_pose(motion: &Motion, f: usize) -> Option<Vec<Transform>> {
-    let row = motion.frame(f)?;
-    let skeleton = motion.skeleton();
+    Some(world_transforms(motion.skeleton(), motion.frame(f)?))
+}
+
+/// World transforms of every joint of `skeleton` for one frame's channel values `row`
+/// (values past the end of `row` count as 0).
+pub fn world_transforms(skeleton: &Skeleton, row: &[f64]) -> Vec<Transform> {
     let mut out: Vec<Transform> = Vec::with_capacity(skeleton.joints.len());
     let mut start = 0;
     for joint in &skeleton.joints {
@@ -92,7 +96,7 @@ pub fn world_pose(motion: &Motion, f: usize) -> Option<Vec<Transform>> {
             },
         });
     }
-    Some(out)
+    out
 }
 
 /// A point whose world position FK can compute.

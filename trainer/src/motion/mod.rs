@@ -6,6 +6,7 @@
 //! | [`bvh_read`] | the BVH reader, [`BvhError`] (file:line messages) |
 //! | [`bvh_write`] | the BVH writer |
 //! | [`fk`] | forward kinematics (per-joint rotation order), [`Positions`], the [`FkPlan`] fast path |
+//! | [`humanoid`] | humanoid bones (Unity's `HumanBodyBones` names) found by common joint naming |
 //! | [`effectors`] | which points to follow: the two hands by name, or any named joints |
 //! | [`segment`] | mean effector speed, threshold cuts with hysteresis and a minimum length |
 //! | [`kinematic`] | y = (T, D, V, A, C, H) per segment, log scale, corpus [`Normalization`] |
@@ -26,6 +27,7 @@ pub mod bvh_read;
 pub mod bvh_write;
 pub mod effectors;
 pub mod fk;
+pub mod humanoid;
 pub mod kinematic;
 pub mod segment;
 pub mod skeleton;
