@@ -1,4 +1,4 @@
-//! Rig files: the sample puppet rig on the synthetic, ZeroEGGS and Bandai Namco skeletons,
+//! Rig files: the sample puppet rig (body channels) on the synthetic, ZeroEGGS and Bandai Namco skeletons,
 //! the angle convention on planted rotations, the full-skeleton rig, and bad rig files.
 //! Tests on `../shared/data` print "skipping: ..." and pass when it is absent.
 
@@ -104,11 +104,11 @@ fn puppet_binds_to_the_synthetic_skeleton_and_moves() {
             "RightForeArm"
         ]
     );
+    // Body channels: the head and both arms are measured in the chest's body frame (the
+    // nearest common ancestor of the head and the upper arms), so a clavicle's own turn counts
+    // in the arm's direction, as it does in what the audience sees.
     assert_eq!(bound.channels()[0].reference.as_deref(), Some("Chest"));
-    assert_eq!(
-        bound.channels()[2].reference.as_deref(),
-        Some("LeftShoulder")
-    );
+    assert_eq!(bound.channels()[2].reference.as_deref(), Some("Chest"));
     let take = synth::generate_take(7, 0, 20.0, &synth::speaker_for(7));
     let r = ranges(&rig, &take.motion(), "synthetic take");
     // The synthetic right arm strokes; its shoulder and elbow must move.
@@ -253,8 +253,10 @@ fn puppet_binds_to_every_bandai_clip() {
     for p in &files {
         let m = read_bvh(p).unwrap();
         let bound = rig.bind(m.skeleton(), &p.display().to_string()).unwrap();
-        // The Bandai head's frame has X up: the `when_skeleton_has` alias must have won.
-        assert_eq!(bound.channels()[0].axis.to_string(), "X");
+        // No per-skeleton alias: the head is a body measure in the chest's body frame, which
+        // comes from the geometry, not from Bandai's joint frames (X up at the chest).
+        assert_eq!(bound.channels()[0].mode.to_string(), "body head_pan");
+        assert_eq!(bound.channels()[0].joint_name, "Head");
         assert_eq!(bound.channels()[0].reference.as_deref(), Some("Chest"));
         let values = bound.take_values(&m).unwrap();
         assert!(values.iter().flatten().all(|v| v.is_finite()));
@@ -447,6 +449,23 @@ fn other_bad_rigs() {
             "empty `joint` list",
         ),
         (
+            one_channel(CAL).replace("joint = [\"LeftForeArm\", \"lowerarm_l\"]", ""),
+            "empty `joint` list and no `body`",
+        ),
+        (
+            one_channel(CAL).replace("axis = \"Y\"", ""),
+            "needs an `axis`",
+        ),
+        (
+            one_channel(&format!("body = \"tail_wag\"\n{CAL}")),
+            "unknown body measure `tail_wag`; use one of head_pan,",
+        ),
+        (
+            one_channel(&format!("body = \"left_elbow_flex\"\n{CAL}"))
+                .replace("joint = [\"LeftForeArm\", \"lowerarm_l\"]", ""),
+            "`axis` applies to `joint` aliases and this channel has none",
+        ),
+        (
             one_channel(&format!("mode = \"euler\"\n{CAL}")),
             "needs an `order`",
         ),
@@ -514,4 +533,36 @@ fn other_bad_rigs() {
             .starts_with("/nonexistent/rig.toml: cannot read"),
         "{e}"
     );
+}
+
+/// The alias format of earlier rig files (per-skeleton joint names and axes, as the shipped
+/// puppet used before its channels became body measures) still parses and binds, and a
+/// channel with both `joint` and `body` reads the joint where an alias applies and the body
+/// measure elsewhere.
+#[test]
+fn joint_alias_rigs_still_work_and_override_body_measures() {
+    let old = "name = \"old\"\nperiod_us = 20000\n\n[[channel]]\nname = \"head_pan\"\n\
+               joint = [{ name = \"Head\", axis = \"X\", when_skeleton_has = \"joint_Root\" }, \"Head\"]\n\
+               axis = \"Y\"\nrelative_to = [\"Spine3\", \"Chest\"]\n\
+               neutral_deg = 0\nmin_deg = -60\nmax_deg = 60\ndirection = 1\n\
+               pulse_neutral_us = 1500\nus_per_deg = 10\nmax_slew_deg_per_s = 200\n\n\
+               [[channel]]\nname = \"left_elbow\"\njoint = [\"NoSuchJoint\"]\naxis = \"-Y\"\n\
+               body = \"left_elbow_flex\"\n\
+               neutral_deg = 20\nmin_deg = 0\nmax_deg = 150\ndirection = 1\n\
+               pulse_neutral_us = 950\nus_per_deg = 10\nmax_slew_deg_per_s = 300\n";
+    let rig = Rig::parse(old, "old.toml").unwrap_or_else(|e| panic!("{e}"));
+    let bound = rig.bind(&synth::skeleton(), "synthetic").unwrap();
+    let c = bound.channels();
+    assert_eq!(
+        (c[0].mode, c[0].axis.to_string()),
+        (AngleMode::Twist, "Y".to_string())
+    );
+    assert_eq!(c[0].reference.as_deref(), Some("Chest"));
+    assert_eq!(c[1].mode.to_string(), "body left_elbow_flex");
+    // Where the alias applies, the joint wins over the body measure.
+    let text = old.replace("NoSuchJoint", "LeftForeArm");
+    let rig = Rig::parse(&text, "old.toml").unwrap();
+    let bound = rig.bind(&synth::skeleton(), "synthetic").unwrap();
+    assert_eq!(bound.channels()[1].mode, AngleMode::Twist);
+    assert_eq!(bound.channels()[1].joint_name, "LeftForeArm");
 }

@@ -115,6 +115,9 @@ pub fn run(a: &PackArgs) -> Result<(), CliError> {
         r.rig,
         r.channels
     )?;
+    for line in &r.rig_channels {
+        outln!("  {line}")?;
+    }
     outln!(
         "lower body: {}",
         r.lower_body

@@ -137,6 +137,9 @@ pub struct PackReport {
     pub rig: String,
     /// Rig channels.
     pub channels: usize,
+    /// One line per rig channel: what it reads on the library's skeleton, or why it holds
+    /// its neutral.
+    pub rig_channels: Vec<String>,
     /// Library frames stored.
     pub frames: usize,
     /// How the lower body is played (`null`: as captured, or no legs).
@@ -244,6 +247,7 @@ impl PackReport {
             regret_decisions: decisions,
             rig: rig.name.clone(),
             channels: rig.channels.len(),
+            rig_channels: stages.sections.rig_lines.clone(),
             frames: stages.sections.frames,
             lower_body: stages.source.lower_body.as_ref().map(|p| {
                 format!(

@@ -34,6 +34,9 @@ pub struct Sections {
     skeleton: Option<OwnedSkeleton>,
     /// Library frames stored.
     pub frames: usize,
+    /// One line per rig channel saying what it reads on the library's skeleton, or why it
+    /// holds its neutral.
+    pub rig_lines: Vec<String>,
 }
 
 /// The joints of `skeleton` as the writer takes them.
@@ -111,6 +114,10 @@ impl Sections {
     ) -> Result<Self, PackError> {
         let (lib, rig) = (&source.lib, &source.rig);
         let labelling = source.labelling.as_ref();
+        // The body channels' frame comes from the library's first frame, for every take (the
+        // blob's rest pose, from which the simulator takes it again).
+        let rest: Vec<f64> = lib.takes[0].motion.frame(0).unwrap_or(&[]).to_vec();
+        let mut rig_lines = Vec::new();
         // Channel angles of every frame, take after take.
         let mut frames: Vec<Vec<f32>> = Vec::new();
         let mut offsets = Vec::with_capacity(lib.takes.len());
@@ -124,7 +131,12 @@ impl Sections {
             let speed = smoothed_hand_speed(&hands, t.motion.fps());
             beats.extend(speed_minima(&speed).into_iter().map(|b| frames.len() + b));
             speeds.push((frames.len(), speed));
-            let bound = rig.bind(t.motion.skeleton(), &t.source.display().to_string())?;
+            let bound = rig
+                .bind(t.motion.skeleton(), &t.source.display().to_string())?
+                .with_rest(t.motion.skeleton(), &rest);
+            if rig_lines.is_empty() {
+                rig_lines = bound.describe();
+            }
             offsets.push(frames.len());
             let values = bound.take_values(&t.motion).ok_or_else(|| {
                 EncodeError::Inconsistent(format!(
@@ -165,7 +177,6 @@ impl Sections {
             let first = &lib.takes[0];
             let sk = first.motion.skeleton();
             let bound = rig.bind(sk, &first.source.display().to_string())?;
-            let rest: Vec<f64> = first.motion.frame(0).unwrap_or(&[]).to_vec();
             let drives = bound.drives().ok_or(EncodeError::TooLarge {
                 what: "skeleton joints",
                 value: sk.joints.len(),
@@ -203,6 +214,7 @@ impl Sections {
             rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
             skeleton,
             frames: n,
+            rig_lines,
         })
     }
 

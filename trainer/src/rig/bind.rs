@@ -7,16 +7,20 @@
 use gesture_runtime::blob::{BvhChannel, Drive, DriveMode};
 use gesture_runtime::rotation::{euler_angles, identity, mat_mul, twist_deg, wrap_deg, Mat3};
 
+use super::body::{Body, BodyMeasure, BodyPart, Effector};
 use super::spec::{AngleMode, Axis, Rig, RigChannel, RigError};
-use crate::motion::fk::local_transform;
+use crate::motion::fk::{local_transform, world_transforms};
 use crate::motion::{Motion, Skeleton};
 
 impl Rig {
     /// Resolves every channel's joint in `skeleton` (`source` names it in messages, e.g. the
     /// BVH path): the first alias, in order, whose name is a joint (ignoring ASCII case) and
     /// whose `when_skeleton_has` joint, if any, exists.
+    /// A channel none of whose aliases applies reads its `body` measure, if it has one (and
+    /// holds its neutral if the skeleton lacks that part); without one it is an error.
     pub fn bind(&self, skeleton: &Skeleton, source: &str) -> Result<BoundRig, RigError> {
         let starts = skeleton.channel_starts();
+        let body = Body::find(skeleton);
         let mut channels = Vec::with_capacity(self.channels.len());
         for c in &self.channels {
             let found = c.joint_aliases.iter().find_map(|a| {
@@ -30,6 +34,10 @@ impl Rig {
                 skeleton.find_ignore_case(&a.name).map(|j| (j, a))
             });
             let Some((joint, alias)) = found else {
+                if let Some(m) = c.body {
+                    channels.push(body_channel(c, m, &body, skeleton, &starts));
+                    continue;
+                }
                 return Err(RigError::MissingJoint {
                     skeleton: source.to_string(),
                     rig: self.name.clone(),
@@ -55,6 +63,9 @@ impl Rig {
                     .and_then(|&j| skeleton.joints[j].parent)
                     .map(|p| skeleton.joints[p].name.clone()),
                 chain: chain.into_iter().map(|j| (j, starts[j])).collect(),
+                held: None,
+                neutral: c.cal.neutral_deg,
+                detail: String::new(),
             });
         }
         Ok(BoundRig {
@@ -63,7 +74,72 @@ impl Rig {
             joints: skeleton.joints.len(),
             channel_count: skeleton.channel_count(),
             channels,
+            body,
+            axes: None,
+            rest_given: false,
         })
+    }
+}
+
+/// Channel `c` reading body measure `m` (or holding its neutral when the skeleton lacks it).
+fn body_channel(
+    c: &RigChannel,
+    m: BodyMeasure,
+    body: &Body,
+    skeleton: &Skeleton,
+    starts: &[usize],
+) -> BoundChannel {
+    let name = |j: usize| skeleton.joints.get(j).map_or("", |x| x.name.as_str());
+    let point = |e: Effector| match e {
+        Effector::Joint(j) => format!("`{}`", name(j)),
+        Effector::EndSite(j) => format!("`{}`'s end site", name(j)),
+    };
+    let (joint, chest) = match (body.joint(m), body.chest) {
+        (Some(j), Some(chest)) => (j, chest),
+        _ => {
+            return BoundChannel {
+                name: c.name.clone(),
+                joint: 0,
+                joint_name: name(0).to_string(),
+                axis: c.axis,
+                mode: AngleMode::Body(m),
+                reference: None,
+                chain: Vec::new(),
+                held: Some(
+                    body.missing(m)
+                        .unwrap_or_else(|| "no such part".to_string()),
+                ),
+                neutral: c.cal.neutral_deg,
+                detail: String::new(),
+            }
+        }
+    };
+    let detail = match (m.part(), body.arms) {
+        (BodyPart::Head, _) => format!("`{}`", name(joint)),
+        (BodyPart::UpperArm(s), arms) => arms[s].map_or(String::new(), |a| {
+            format!("`{}` -> {}", name(a.upper), point(a.elbow))
+        }),
+        (BodyPart::Elbow(s), arms) => arms[s].map_or(String::new(), |a| {
+            let wrist = a.wrist.map_or(String::new(), point);
+            format!(
+                "{} -> {} -> {wrist}",
+                point(Effector::Joint(a.upper)),
+                point(a.elbow)
+            )
+        }),
+    };
+    BoundChannel {
+        name: c.name.clone(),
+        joint,
+        joint_name: name(joint).to_string(),
+        axis: c.axis,
+        mode: AngleMode::Body(m),
+        reference: Some(name(chest).to_string()),
+        // The chest: the drive record's `chain_top` (the reference), not a rotation chain.
+        chain: vec![(chest, starts[chest])],
+        held: None,
+        neutral: c.cal.neutral_deg,
+        detail,
     }
 }
 
@@ -158,8 +234,15 @@ pub struct BoundChannel {
     pub mode: AngleMode,
     /// The joint whose frame is the reference (`None` for a root without `relative_to`).
     pub reference: Option<String>,
-    /// (joint, first channel in a frame) from the reference's child down to `joint`.
+    /// (joint, first channel in a frame) from the reference's child down to `joint`; for a
+    /// body measure, just the chest.
     chain: Vec<(usize, usize)>,
+    /// Why the channel holds its neutral (the skeleton lacks its body part), or `None`.
+    pub held: Option<String>,
+    /// The calibration's neutral, the value of a held channel.
+    neutral: f32,
+    /// For a body measure: the bones it reads, for [`BoundChannel::describe`].
+    detail: String,
 }
 
 impl BoundChannel {
@@ -167,6 +250,31 @@ impl BoundChannel {
     /// `relative_to` the reference's child on the path down to `joint`.
     pub fn chain_top(&self) -> usize {
         self.chain.first().map_or(self.joint, |&(j, _)| j)
+    }
+
+    /// One line saying what the channel reads on this skeleton (what `pack` prints).
+    pub fn describe(&self) -> String {
+        if let Some(why) = &self.held {
+            return format!(
+                "{}: held at its neutral {} deg: the skeleton has {why}",
+                self.name, self.neutral
+            );
+        }
+        match self.mode {
+            AngleMode::Body(m) => format!(
+                "{}: {m} of {} in the body frame of `{}`",
+                self.name,
+                self.detail,
+                self.reference.as_deref().unwrap_or("")
+            ),
+            mode => format!(
+                "{}: {mode} about {} of joint `{}` in the frame of `{}`",
+                self.name,
+                self.axis,
+                self.joint_name,
+                self.reference.as_deref().unwrap_or("the world")
+            ),
+        }
     }
 }
 
@@ -178,12 +286,55 @@ pub struct BoundRig {
     joints: usize,
     channel_count: usize,
     channels: Vec<BoundChannel>,
+    body: Body,
+    /// The body frame in the chest's frame, fixed by [`BoundRig::with_rest`].
+    axes: Option<Mat3>,
+    /// Whether [`BoundRig::with_rest`] fixed the body frame (or found none).
+    rest_given: bool,
 }
 
 impl BoundRig {
     /// The resolved channels, in rig order.
     pub fn channels(&self) -> &[BoundChannel] {
         &self.channels
+    }
+
+    /// Fixes the body frame of the body channels from `rest` (one frame's channel values of the
+    /// bound skeleton, e.g. the library's first frame, which the blob stores as its rest
+    /// pose). Without it each motion's own first frame is used. A `rest` of the wrong length
+    /// is ignored.
+    pub fn with_rest(mut self, skeleton: &Skeleton, rest: &[f64]) -> BoundRig {
+        if self.matches(skeleton) && rest.len() == self.channel_count {
+            self.axes = self.body.axes(&world_transforms(skeleton, rest));
+            self.rest_given = true;
+        }
+        self
+    }
+
+    /// The skeleton's humanoid parts, as the body channels found them.
+    pub fn body(&self) -> &Body {
+        &self.body
+    }
+
+    /// One line per channel: what it reads, or why it holds its neutral; after
+    /// [`BoundRig::with_rest`], a body channel also holds it when the rest frame gives no body
+    /// frame (no shoulders or hips to take left-right from).
+    pub fn describe(&self) -> Vec<String> {
+        self.channels
+            .iter()
+            .map(|c| match c.mode {
+                AngleMode::Body(_)
+                    if c.held.is_none() && self.rest_given && self.axes.is_none() =>
+                {
+                    format!(
+                    "{}: held at its neutral {} deg: no body frame (no two upper arms or upper \
+                     legs for left-right, or no hips)",
+                    c.name, c.neutral
+                )
+                }
+                _ => c.describe(),
+            })
+            .collect()
     }
 
     /// The rig's name.
@@ -210,6 +361,26 @@ impl BoundRig {
     /// Every channel's angle (degrees, see the module docs for the convention) at frame
     /// `frame`; `None` if the frame is out of range or `motion` is not of the bound skeleton.
     pub fn channel_values(&self, motion: &Motion, frame: usize) -> Option<Vec<f32>> {
+        self.values_with(motion, frame, self.axes_for(motion).as_ref())
+    }
+
+    /// The body frame: the one fixed by [`BoundRig::with_rest`], else from `motion`'s first
+    /// frame (`None` too when no channel reads a body measure).
+    fn axes_for(&self, motion: &Motion) -> Option<Mat3> {
+        let reads_body = self
+            .channels
+            .iter()
+            .any(|c| matches!(c.mode, AngleMode::Body(_)) && c.held.is_none());
+        if !reads_body || !self.matches(motion.skeleton()) {
+            return None;
+        }
+        self.axes.or_else(|| {
+            let rest = motion.frame(0)?;
+            self.body.axes(&world_transforms(motion.skeleton(), rest))
+        })
+    }
+
+    fn values_with(&self, motion: &Motion, frame: usize, axes: Option<&Mat3>) -> Option<Vec<f32>> {
         let skeleton = motion.skeleton();
         if !self.matches(skeleton) {
             return None;
@@ -227,6 +398,7 @@ impl BoundRig {
                 )
             })
         };
+        let world = axes.map(|_| world_transforms(skeleton, row));
         Some(
             self.channels
                 .iter()
@@ -249,6 +421,13 @@ impl BoundRig {
                                 .unwrap_or(0.0);
                             c.axis.sign() * wrap_deg(raw)
                         }
+                        AngleMode::Body(m) => match (&world, axes, &c.held) {
+                            (Some(w), Some(a), None) => self
+                                .body
+                                .measure(skeleton, w, a, m)
+                                .unwrap_or(f64::from(c.neutral)),
+                            _ => f64::from(c.neutral),
+                        },
                     };
                     deg as f32
                 })
@@ -259,8 +438,9 @@ impl BoundRig {
     /// [`BoundRig::channel_values`] for every frame of `motion` (frames x channels); `None` if
     /// `motion` is not of the bound skeleton.
     pub fn take_values(&self, motion: &Motion) -> Option<Vec<Vec<f32>>> {
+        let axes = self.axes_for(motion);
         (0..motion.frames())
-            .map(|f| self.channel_values(motion, f))
+            .map(|f| self.values_with(motion, f, axes.as_ref()))
             .collect()
     }
 
@@ -274,12 +454,17 @@ impl BoundRig {
                     AngleMode::Twist => DriveMode::Twist,
                     AngleMode::Channel => DriveMode::Channel,
                     AngleMode::Euler(o) => DriveMode::Euler([o[0] as u8, o[1] as u8, o[2] as u8]),
+                    AngleMode::Body(m) => DriveMode::Body(m.index()),
                 };
                 Some(Drive {
                     joint: u16::try_from(c.joint).ok()?,
                     chain_top: u16::try_from(c.chain_top()).ok()?,
-                    axis: c.axis.index.min(2) as u8,
-                    negated: c.axis.negated,
+                    axis: if matches!(mode, DriveMode::Body(_)) {
+                        0
+                    } else {
+                        c.axis.index.min(2) as u8
+                    },
+                    negated: c.axis.negated && !matches!(mode, DriveMode::Body(_)),
                     mode,
                 })
             })

@@ -9,7 +9,9 @@ use gesture_runtime::rig::{validate_period, ChannelCal, MAX_CHANNELS};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 
+use super::body::BodyMeasure;
 use super::spec::{parse_order, AngleMode, Axis, JointAlias, Rig, RigChannel, RigError};
+use gesture_runtime::blob::BODY_MEASURES;
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -24,8 +26,12 @@ struct RawRig {
 #[serde(deny_unknown_fields)]
 struct RawChannel {
     name: toml::Spanned<String>,
+    #[serde(default)]
     joint: Vec<RawAlias>,
-    axis: String,
+    #[serde(default)]
+    body: Option<String>,
+    #[serde(default)]
+    axis: Option<String>,
     #[serde(default)]
     mode: Option<String>,
     #[serde(default)]
@@ -154,7 +160,56 @@ impl Rig {
                     value: value.to_string(),
                 })
             };
-            let axis = axis_of(&c.axis)?;
+            let bad = |reason: String| RigError::BadChannel {
+                path: path.clone(),
+                line,
+                channel: name.clone(),
+                reason,
+            };
+            let body = match c.body.as_deref() {
+                None => None,
+                Some(text) => Some(BodyMeasure::parse(text).ok_or_else(|| {
+                    bad(format!(
+                        "unknown body measure `{text}`; use one of {}",
+                        BODY_MEASURES.join(", ")
+                    ))
+                })?),
+            };
+            if c.joint.is_empty() && body.is_none() {
+                return Err(RigError::NoJointAliases {
+                    path,
+                    line,
+                    channel: name,
+                });
+            }
+            if c.joint.is_empty() {
+                let extra = [
+                    ("axis", c.axis.is_some()),
+                    ("mode", c.mode.is_some()),
+                    ("order", c.order.is_some()),
+                    ("relative_to", !c.relative_to.is_empty()),
+                ];
+                if let Some((key, _)) = extra.iter().find(|(_, given)| *given) {
+                    return Err(bad(format!(
+                        "`{key}` applies to `joint` aliases and this channel has none (a `body` \
+                         measure needs no axis); remove it or add a `joint` list"
+                    )));
+                }
+            }
+            let axis = match c.axis.as_deref() {
+                Some(text) => axis_of(text)?,
+                None if c.joint.is_empty() => Axis {
+                    index: 0,
+                    negated: false,
+                },
+                None => {
+                    return Err(bad(
+                        "a channel with `joint` aliases needs an `axis` (X, Y or Z, e.g. \
+                         axis = \"Y\")"
+                            .to_string(),
+                    ))
+                }
+            };
             let mut joint_aliases = Vec::with_capacity(c.joint.len());
             for RawAlias(a) in c.joint {
                 joint_aliases.push(JointAlias {
@@ -163,19 +218,6 @@ impl Rig {
                     when_skeleton_has: a.when_skeleton_has,
                 });
             }
-            if joint_aliases.is_empty() {
-                return Err(RigError::NoJointAliases {
-                    path,
-                    line,
-                    channel: name,
-                });
-            }
-            let bad = |reason: String| RigError::BadChannel {
-                path: path.clone(),
-                line,
-                channel: name.clone(),
-                reason,
-            };
             let mode = match c.mode.as_deref().map(str::to_ascii_lowercase).as_deref() {
                 None | Some("twist") => AngleMode::Twist,
                 Some("channel") => AngleMode::Channel,
@@ -229,6 +271,7 @@ impl Rig {
             channels.push(RigChannel {
                 name,
                 joint_aliases,
+                body,
                 axis,
                 mode,
                 relative_to: c.relative_to,

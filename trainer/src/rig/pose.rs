@@ -26,13 +26,14 @@
 //! Everything here is `f64`; nothing panics on a validated blob (the section's indices were
 //! checked at load).
 
-use gesture_runtime::blob::{BvhChannel, DriveMode, SkeletonView};
+use gesture_runtime::blob::{BvhChannel, Drive, DriveMode, SkeletonView};
 use gesture_runtime::rotation::{
     axis_rotation, euler_angles, euler_matrix, identity, mat_mul, transpose, twist_deg, Mat3,
 };
 
+use super::body::{Body, BodyMeasure, BodyPart};
 use super::spec::Axis;
-use crate::motion::fk::local_transform;
+use crate::motion::fk::{local_transform, world_transforms, Transform};
 use crate::motion::{Joint, Motion, MotionError, Skeleton};
 
 /// The blob's skeleton, rest frame and rig channel drives, ready to rebuild frames.
@@ -43,6 +44,10 @@ pub struct PoseSkeleton {
     starts: Vec<usize>,
     /// Per rig channel: (joint, chain top, axis, mode).
     drives: Vec<(usize, usize, Axis, DriveMode)>,
+    /// The humanoid parts, found by name as the packer found them.
+    body: Body,
+    /// The body frame in the chest's frame, from the rest frame (as the packer took it).
+    axes: Option<Mat3>,
 }
 
 impl PoseSkeleton {
@@ -59,9 +64,18 @@ impl PoseSkeleton {
             .collect();
         let skeleton = Skeleton { joints };
         skeleton.validate()?;
-        let rest = (0..v.channel_count()).map(|i| v.rest(i) as f64).collect();
-        let drives = (0..v.drives())
-            .filter_map(|ch| v.drive(ch))
+        let rest: Vec<f64> = (0..v.channel_count()).map(|i| v.rest(i) as f64).collect();
+        let drives: Vec<Drive> = (0..v.drives()).filter_map(|ch| v.drive(ch)).collect();
+        Ok(Self::new(skeleton, rest, &drives))
+    }
+
+    /// From a skeleton, its rest frame (one value per channel) and the rig channels' drives
+    /// (what the packer writes in the blob; `BoundRig::drives`). The drives' indices must be
+    /// valid for `skeleton` and `rest` must have its channel count, as a validated blob
+    /// guarantees.
+    pub fn new(skeleton: Skeleton, rest: Vec<f64>, drives: &[Drive]) -> Self {
+        let drives = drives
+            .iter()
             .map(|d| {
                 let axis = Axis {
                     index: d.axis as usize,
@@ -70,12 +84,16 @@ impl PoseSkeleton {
                 (d.joint as usize, d.chain_top as usize, axis, d.mode)
             })
             .collect();
-        Ok(Self {
+        let body = Body::find(&skeleton);
+        let axes = body.axes(&world_transforms(&skeleton, &rest));
+        Self {
             starts: skeleton.channel_starts(),
             skeleton,
             rest,
             drives,
-        })
+            body,
+            axes,
+        }
     }
 
     /// The skeleton.
@@ -156,7 +174,7 @@ impl PoseSkeleton {
         let mut joints: Vec<usize> = self
             .drives
             .iter()
-            .filter(|d| d.3 != DriveMode::Channel)
+            .filter(|d| matches!(d.3, DriveMode::Twist | DriveMode::Euler(_)))
             .map(|d| d.0)
             .collect();
         joints.sort_unstable();
@@ -166,7 +184,7 @@ impl PoseSkeleton {
                 .drives
                 .iter()
                 .zip(pose)
-                .filter(|(d, _)| d.0 == j && d.3 != DriveMode::Channel)
+                .filter(|(d, _)| d.0 == j && matches!(d.3, DriveMode::Twist | DriveMode::Euler(_)))
                 .map(|(d, &v)| (d.1, d.2, d.3, v as f64))
                 .collect();
             let top = mine[0].0;
@@ -191,13 +209,74 @@ impl PoseSkeleton {
                         }
                         r = euler_matrix(order, a);
                     }
-                    DriveMode::Channel => {}
+                    DriveMode::Channel | DriveMode::Body(_) => {}
                 }
             }
             let local = mat_mul(&transpose(&above), &r);
             self.set_local_rotation(&mut frame, j, &local);
         }
+        self.pose_body(&mut frame, pose);
         frame
+    }
+
+    /// The body measures of `pose` (see the module docs): the head, then each upper arm, then
+    /// each elbow, each turned the least that shows its values.
+    fn pose_body(&self, frame: &mut [f64], pose: &[f32]) {
+        let Some(axes) = self.axes else { return };
+        let mut want = [None::<f64>; 9];
+        for (d, &v) in self.drives.iter().zip(pose) {
+            if let DriveMode::Body(k) = d.3 {
+                if let Some(slot) = want.get_mut(usize::from(k)) {
+                    *slot = Some(f64::from(v));
+                }
+            }
+        }
+        let measure = |k: u8| BodyMeasure::from_index(k).filter(|&m| self.body.joint(m).is_some());
+        let wanted = |k: u8| measure(k).and(want[usize::from(k)]);
+        let mut world = world_transforms(&self.skeleton, frame);
+        let head = [wanted(0), wanted(1), wanted(2)];
+        if head.iter().any(Option::is_some) {
+            if let Some((j, r)) = self.body.head_target(&world, &axes, head) {
+                self.set_world_rotation(frame, &mut world, j, &r);
+            }
+        }
+        for (s, (raise, swing, flex)) in [(3u8, 4u8, 7u8), (5, 6, 8)].into_iter().enumerate() {
+            let arm = [wanted(raise), wanted(swing)];
+            if arm.iter().any(Option::is_some) {
+                if let Some((j, r)) =
+                    self.body
+                        .upper_arm_target(&self.skeleton, &world, &axes, s, arm)
+                {
+                    self.set_world_rotation(frame, &mut world, j, &r);
+                }
+            }
+            debug_assert!(matches!(
+                BodyMeasure::from_index(flex).map(BodyMeasure::part),
+                Some(BodyPart::Elbow(_))
+            ));
+            if let Some(v) = wanted(flex) {
+                if let Some((j, r)) = self.body.elbow_target(&self.skeleton, &world, &axes, s, v) {
+                    self.set_world_rotation(frame, &mut world, j, &r);
+                }
+            }
+        }
+    }
+
+    /// Gives joint `j` the local rotation that makes its world rotation `r` (its parent's
+    /// unchanged), then updates `world`.
+    fn set_world_rotation(
+        &self,
+        frame: &mut [f64],
+        world: &mut Vec<Transform>,
+        j: usize,
+        r: &Mat3,
+    ) {
+        let parent = self.skeleton.joints[j]
+            .parent
+            .and_then(|p| world.get(p))
+            .map_or_else(identity, |t| t.rotation);
+        self.set_local_rotation(frame, j, &mat_mul(&transpose(&parent), r));
+        *world = world_transforms(&self.skeleton, frame);
     }
 
     /// A motion of `poses` at `fps` frames per second.

@@ -7,6 +7,7 @@ use std::fmt;
 
 use gesture_runtime::rig::{CalError, ChannelCal, MAX_CHANNELS};
 
+use super::body::BodyMeasure;
 use crate::motion::Skeleton;
 
 /// A rotation axis of a joint's parent frame, possibly negated.
@@ -67,6 +68,9 @@ pub enum AngleMode {
     Euler([usize; 3]),
     /// The joint's own BVH rotation channel about the axis, wrapped to `[-180, 180]`.
     Channel,
+    /// A body measure (the channel's `body` key, see the module docs): set on a
+    /// [`BoundChannel`](super::BoundChannel) that reads it; never a rig file's `mode`.
+    Body(BodyMeasure),
 }
 
 impl fmt::Display for AngleMode {
@@ -74,6 +78,7 @@ impl fmt::Display for AngleMode {
         match self {
             AngleMode::Twist => f.write_str("twist"),
             AngleMode::Channel => f.write_str("channel"),
+            AngleMode::Body(m) => write!(f, "body {m}"),
             AngleMode::Euler(order) => {
                 f.write_str("euler ")?;
                 for &o in order {
@@ -127,11 +132,13 @@ impl fmt::Display for JointAlias {
 pub struct RigChannel {
     /// The channel's name (unique within the rig).
     pub name: String,
-    /// Joint names to follow, tried in order.
+    /// Joint names to follow, tried in order (may be empty for a channel with a `body`).
     pub joint_aliases: Vec<JointAlias>,
-    /// The axis (of the joint's parent frame) the angle is measured about.
+    /// The body measure to read when no joint alias applies (the `body` key).
+    pub body: Option<BodyMeasure>,
+    /// The axis (of the joint's parent frame) the angle is measured about (joint aliases only).
     pub axis: Axis,
-    /// How the angle is read.
+    /// How the angle is read from a joint alias.
     pub mode: AngleMode,
     /// Ancestor joint names whose frame is the reference, tried in order (empty: the parent).
     pub relative_to: Vec<String>,
@@ -267,7 +274,8 @@ pub enum RigError {
     },
     /// A channel lists no joint.
     #[error(
-        "{path}:{line}: channel `{channel}` has an empty `joint` list; name at least one joint"
+        "{path}:{line}: channel `{channel}` has an empty `joint` list and no `body`; name at \
+         least one joint, or a body measure such as body = \"head_pan\""
     )]
     NoJointAliases {
         /// The path as given.
@@ -336,6 +344,7 @@ impl Rig {
                             axis: None,
                             when_skeleton_has: None,
                         }],
+                        body: None,
                         axis: Axis {
                             index: c.axis(),
                             negated: false,
