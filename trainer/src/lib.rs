@@ -24,8 +24,8 @@
 //!   Fig. 4's comparison, and the inference section of the blob.
 //! - [`control`]: the control layer: library, costs, value iteration, pruning, the offline DP
 //!   reference and the motion-quality metrics.
-//! - [`rig`]: TOML rig files (output channels mapped to joint rotations by name aliases, with
-//!   servo calibration), binding to a skeleton, per-frame channel angles, the full-skeleton
+//! - [`rig`]: TOML rig files (output channels mapped to body measures of any humanoid skeleton
+//!   or to joint rotations by name aliases, with servo calibration), binding to a skeleton, per-frame channel angles, the full-skeleton
 //!   rig, and rig poses back on the skeleton.
 //! - [`pack`]: model + library + rig into a policy blob (in memory or to a file), with its
 //!   report.

@@ -17,6 +17,14 @@
 //!   makes its chain equal `R` (joints above it in the chain keep their values), written in its
 //!   own channel order.
 //!
+//! - **body** channels come last: the parts and the body frame are found on the blob's skeleton
+//!   and rest frame exactly as the packer found them (same names, same rest frame); the head
+//!   gets the rotation relative to the chest that shows its pan, tilt and roll (the neck
+//!   keeps its rest values), each upper arm the least turn that points it at its raise and
+//!   swing, then each forearm the turn about the elbow's hinge (forward for a straight arm)
+//!   to its flex. Each is exact, so these read back exactly too (away from an arm pointing
+//!   straight forward or back, where raise is undefined).
+//!
 //! So reading the rig back from the rebuilt frame ([`BoundRig::channel_values`](super::BoundRig::channel_values))
 //! gives the pose again for one channel per joint and for Euler gimbals; two twist channels on
 //! one joint are applied in rig order and the second can disturb the first slightly. Joints no
