@@ -66,6 +66,9 @@ fn pack_both(
     lines
 }
 
+/// (label, files or folders, effectors when the skeleton has no hands).
+type Library = (&'static str, Vec<PathBuf>, Option<[&'static str; 2]>);
+
 #[test]
 fn shipped_puppet_rigs_pack_every_library() {
     let dir = tempfile::tempdir().unwrap();
@@ -104,7 +107,7 @@ fn shipped_puppet_rigs_pack_every_library() {
     let Some(data) = e2e_tests::shared_data("rig_pack", "") else {
         return;
     };
-    let libraries: [(&str, Vec<PathBuf>, Option<[&str; 2]>); 5] = [
+    let libraries: [Library; 5] = [
         (
             "zeroeggs-067",
             vec![data.join("zeroeggs-067-speech2")],
