@@ -238,7 +238,12 @@ fn bad_inputs_give_one_line_exit_2_and_no_files() {
 
     // A rig naming a joint the blob's skeleton does not have.
     let rig = std::fs::read_to_string(workspace().join("rigs/puppet-8ch.toml")).unwrap();
-    let text_rig = rig.replacen("joint = [", "joint = [\"NoSuchJoint\"] # was [", 1);
+    // (The shipped rig's channels are body measures; the first becomes a joint channel.)
+    let text_rig = rig.replacen(
+        "body = \"head_pan\"",
+        "joint = [\"NoSuchJoint\"]\naxis = \"Y\"",
+        1,
+    );
     let rig_path = bad.join("missing-joint.toml");
     std::fs::write(&rig_path, text_rig).unwrap();
     assert!(Rig::load(&rig_path).is_ok(), "the rig file itself parses");
