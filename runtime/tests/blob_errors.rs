@@ -656,8 +656,10 @@ fn every_error_variant_is_reachable() {
         &sk(&|s| s.drives[4] = 6),
         BlobError::BadDrive { channel: 0 },
     );
+    // Modes 0..=16 are defined (8..=16 are the body measures); 17 is the first unknown one.
+    assert!(Blob::parse(&sk(&|s| s.drives[5] = 16)).is_ok());
     check(
-        &sk(&|s| s.drives[5] = 8),
+        &sk(&|s| s.drives[5] = 17),
         BlobError::BadDrive { channel: 0 },
     );
     // The chain top must be the joint or an ancestor: hips (0) above head (1) is fine, head
