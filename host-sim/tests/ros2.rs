@@ -205,7 +205,28 @@ fn mcap_and_urdf_of_a_run_open_in_ros_tools() {
 #[test]
 fn puppet_urdf_has_the_rigs_joints_and_limits() {
     let s = setup();
-    let bytes = std::fs::read(&s.puppet).unwrap();
+    // The shipped rig's channels are body measures, which a URDF cannot show (refused, with
+    // the reason); the same puppet in joint-rotation form can.
+    let shipped_bytes = std::fs::read(&s.puppet).unwrap();
+    let shipped = Blob::parse(&shipped_bytes).unwrap();
+    let cals0: Vec<ChannelCal> = (0..shipped.channels())
+        .map(|c| shipped.calibration(c).unwrap())
+        .collect();
+    let refused = Robot::from_blob(&shipped, &cals0).unwrap_err().to_string();
+    assert!(refused.contains("is a body measure"), "{refused}");
+    let joints_blob = s.root.join("puppet-joints.blob");
+    let opts = gesture_trainer::pack::PackOptions {
+        rig: Some(workspace().join("host-sim/tests/data/puppet-8ch-joints.toml")),
+        ..gesture_trainer::pack::PackOptions::default()
+    };
+    gesture_trainer::pack::pack(
+        &s.root.join("model.json"),
+        std::slice::from_ref(&s.corpus),
+        &opts,
+        &joints_blob,
+    )
+    .unwrap();
+    let bytes = std::fs::read(&joints_blob).unwrap();
     let blob = Blob::parse(&bytes).unwrap();
     let cals: Vec<ChannelCal> = (0..blob.channels())
         .map(|c| blob.calibration(c).unwrap())
@@ -258,7 +279,7 @@ fn puppet_urdf_has_the_rigs_joints_and_limits() {
     let o = common::sim(&[
         "urdf",
         "--blob",
-        s.puppet.to_str().unwrap(),
+        joints_blob.to_str().unwrap(),
         "--out",
         file.to_str().unwrap(),
     ]);

@@ -161,6 +161,18 @@ impl Robot {
                 names.len()
             )));
         }
+        if let Some(c) = drives
+            .iter()
+            .position(|d| matches!(d.mode, DriveMode::Body(_)))
+        {
+            return Err(err(format!(
+                "channel `{}` is a body measure (a rig `body` key): the simulator shows it by the \
+                 least turn of its bone, which no chain of URDF revolute joints reproduces; pack \
+                 with a rig whose channels name joints (`joint` and `axis`) or the full-skeleton \
+                 rig for a URDF",
+                names[c]
+            )));
+        }
         let values = |j: usize| {
             let n = sk.joints[j].channels.len();
             &rest[starts[j]..starts[j] + n]
