@@ -285,7 +285,7 @@ pub enum BlobError {
         tone: u32,
     },
     // --- labels ---
-    /// More labels than [`MAX_LABELS`](crate::controller::MAX_LABELS).
+    /// More labels than [`MAX_LABELS`](crate::policy::MAX_LABELS).
     TooManyLabels {
         /// Labels in the blob.
         found: u32,
@@ -579,7 +579,7 @@ impl fmt::Display for BlobError {
             Self::TooManyLabels { found } => write!(
                 f,
                 "{found} labels, the runtime holds at most {} (pack fewer labels)",
-                crate::controller::MAX_LABELS
+                crate::policy::MAX_LABELS
             ),
             Self::BadLabelNames { label } => write!(
                 f,

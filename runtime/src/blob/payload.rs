@@ -75,7 +75,7 @@ pub const ENTRY_RECORD_BYTES: usize = 4;
 /// entered at a frame before its stroke.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LabelsSection<'a> {
-    /// Labels L (1..=[`MAX_LABELS`](crate::controller::MAX_LABELS)); `library.labels` holds
+    /// Labels L (1..=[`MAX_LABELS`](crate::policy::MAX_LABELS)); `library.labels` holds
     /// `1..=L` (0: none).
     pub labels: u8,
     /// L label names separated by `'\n'` (non-empty, distinct).
@@ -262,7 +262,7 @@ pub struct StylesSection<'a> {
 }
 
 /// How the controller runs the policy: when it decides
-/// ([`DecisionTiming`](crate::controller::DecisionTiming)), how it varies its choices
+/// ([`DecisionTiming`](crate::policy::DecisionTiming)), how it varies its choices
 /// ([`Variety`](crate::policy::Variety)) and how the player blends at cuts.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ControlSection {
@@ -299,7 +299,7 @@ impl ControlSection {
     /// The section for timing `t`, variety `v`, following the voice `f` and blend time `blend_ms` (durations saturate
     /// at `u16::MAX`).
     pub fn new(
-        t: &crate::controller::DecisionTiming,
+        t: &crate::policy::DecisionTiming,
         v: &crate::policy::Variety,
         f: &crate::follow::VoiceFollow,
         blend_ms: u32,
@@ -362,7 +362,7 @@ pub struct LibrarySection<'a> {
     pub beats: &'a [u8],
     /// Calm frames: a bit per frame of the frame table (as `beats`), set where the hands'
     /// smoothed speed is at most the library's 30th percentile. A cut decided mid-segment may
-    /// fall on a calm frame or a beat ([`DecisionTiming::defer_cut_ms`](crate::controller::DecisionTiming::defer_cut_ms)).
+    /// fall on a calm frame or a beat ([`DecisionTiming::defer_cut_ms`](crate::policy::DecisionTiming::defer_cut_ms)).
     #[serde(borrow)]
     pub calm: &'a [u8],
     /// `i8` per segment: its energy, the log of its hands' mean speed over the library's

@@ -74,7 +74,7 @@ fn names_ok(names: &str, n: usize, reserved: &str) -> Result<(), u32> {
 
 /// The labels section: the label count, names and cost; `labels.segments` is the increasing
 /// list of exactly the segments whose `library.labels` byte is not 0 (each at most L, each with
-/// a stroke, at most [`MAX_LABELLED`](crate::controller::MAX_LABELLED)); value tables of L
+/// a stroke, at most [`MAX_LABELLED`](crate::policy::MAX_LABELLED)); value tables of L
 /// times the policy's shapes; E x N entry records, each frame at most its segment's stroke.
 fn labels<'a>(
     lb: &LabelsSection<'a>,
@@ -84,7 +84,7 @@ fn labels<'a>(
     let l = lb.labels as usize;
     count(
         l,
-        crate::controller::MAX_LABELS,
+        crate::policy::MAX_LABELS,
         Field::LabelCount,
         BlobError::TooManyLabels { found: l as u32 },
     )?;
@@ -112,7 +112,7 @@ fn labels<'a>(
         let stroke = u16_at(lib.strokes, seg).unwrap_or(NO_STROKE);
         if lab > l
             || stroke == NO_STROKE
-            || k >= crate::controller::MAX_LABELLED
+            || k >= crate::policy::MAX_LABELLED
             || u16_at(lb.segments, k) != Some(seg as u16)
         {
             return Err(BlobError::BadLabelledSegment {

@@ -16,9 +16,9 @@ use super::records::{
 };
 use super::skeleton::SkeletonView;
 use super::validate;
-use crate::controller::DecisionTiming;
 use crate::follow::VoiceFollow;
 use crate::inference::{CrfWeights, GmmComponent, I16Table, MAX_CLUSTERS};
+use crate::policy::DecisionTiming;
 use crate::policy::Variety;
 #[cfg(doc)]
 use crate::prosody::FrontEnd;

@@ -1,17 +1,13 @@
 //! Semantic labels in the controller (docs/method.md "Semantic labels"): the label being
-//! served and the fixed queue behind it, what became of each, and the bookkeeping after every
-//! tick. Fixed memory (a few bytes and a queue of [`LABEL_QUEUE`]); nothing allocates or
+//! served and the fixed queue behind it ([`Labels`]), what became of each, and the bookkeeping
+//! after every tick. The controller owns one [`Labels`] and asks it whether a label waits for
+//! a segment; the policy's tables say which segments carry a label and where their strokes
+//! are. Fixed memory (a few bytes and a queue of [`LABEL_QUEUE`]); nothing allocates or
 //! panics.
 
 use super::event::{ControllerEvent, LabelOutcome};
-use super::Controller;
-use crate::player::LibraryFrames;
 use crate::policy::PolicyTables;
 
-/// Most semantic labels a blob defines.
-pub const MAX_LABELS: usize = 16;
-/// Most segments of a blob that carry a label.
-pub const MAX_LABELLED: usize = 64;
 /// Labels that can wait behind the one being served.
 pub const LABEL_QUEUE: usize = 4;
 
@@ -44,88 +40,101 @@ impl core::error::Error for LabelError {}
 
 /// The label being served.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct ActiveLabel {
+struct ActiveLabel {
     /// Label index (0-based).
-    pub(super) label: u8,
+    label: u8,
     /// Tick it became active.
-    pub(super) since: u64,
+    since: u64,
     /// The segment entered for it and its stroke frame, once entered.
-    pub(super) serving: Option<(usize, usize)>,
+    serving: Option<(usize, usize)>,
 }
 
-impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'_, T, L> {
-    /// Asks for the semantic label `label` (0-based, the blob's order; docs/method.md
-    /// "Semantic labels"): from the next exit point on, the controller prefers the segments
-    /// carrying it and may enter one just before its stroke; the label is served once that
-    /// stroke plays, or dropped after the blob's timeout. A label that arrives while another
-    /// is served waits (at most [`LABEL_QUEUE`]). Reports `Received` through the next call's
-    /// events.
-    pub fn push_label(&mut self, label: usize) -> Result<(), LabelError> {
-        let labels = self.tables.labels();
+/// The label being served and those waiting behind it.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Labels {
+    active: Option<ActiveLabel>,
+    queue: heapless::Deque<u8, LABEL_QUEUE>,
+    /// A label became active and its `Received` event is still to be reported.
+    received: bool,
+}
+
+impl Labels {
+    /// Asks for `label` (0-based) of a blob with `labels` labels at tick `now`: it becomes
+    /// active if none is, else it waits (at most [`LABEL_QUEUE`]).
+    pub(super) fn push(&mut self, label: usize, labels: usize, now: u64) -> Result<(), LabelError> {
         if label >= labels {
             return Err(LabelError::Unknown {
                 label: label.min(u32::MAX as usize) as u32,
-                labels: labels as u32,
+                labels: labels.min(u32::MAX as usize) as u32,
             });
         }
-        if self.active_label.is_none() {
-            self.activate(label as u8);
+        if self.active.is_none() {
+            self.activate(label as u8, now);
             Ok(())
         } else {
-            self.label_queue
+            self.queue
                 .push_back(label as u8)
                 .map_err(|_| LabelError::QueueFull)
         }
     }
 
     /// Drops the label being served and every waiting one.
-    pub fn clear_labels(&mut self) {
-        self.active_label = None;
-        self.label_queue.clear();
+    pub(super) fn clear(&mut self) {
+        self.active = None;
+        self.queue.clear();
     }
 
     /// The label being served (0-based), if any.
-    pub fn active_label(&self) -> Option<usize> {
-        self.active_label.map(|a| a.label as usize)
+    pub(super) fn active(&self) -> Option<usize> {
+        self.active.map(|a| a.label as usize)
     }
 
-    pub(super) fn activate(&mut self, label: u8) {
-        self.active_label = Some(ActiveLabel {
+    /// The active label while it waits for a segment (decisions then come at once and
+    /// prefer the segments carrying it).
+    pub(super) fn waiting(&self) -> Option<u8> {
+        self.active.filter(|a| a.serving.is_none()).map(|a| a.label)
+    }
+
+    /// The active label is served by `segment`, just entered, whose stroke is at `stroke`.
+    pub(super) fn serve(&mut self, segment: usize, stroke: usize) {
+        if let Some(a) = self.active.as_mut() {
+            a.serving = Some((segment, stroke));
+        }
+    }
+
+    fn activate(&mut self, label: u8, now: u64) {
+        self.active = Some(ActiveLabel {
             label,
-            since: self.ticks,
+            since: now,
             serving: None,
         });
-        self.label_received = true;
+        self.received = true;
     }
 
-    /// Whether a label waits for a segment (decisions then come at once).
-    pub(super) fn label_waiting(&self) -> bool {
-        self.active_label.is_some_and(|a| a.serving.is_none())
-    }
-
-    /// Label bookkeeping after a tick that played `frame` of `segment` (`tick`): announces a
-    /// new label, serves it with the segment already playing if that carries it before its
-    /// stroke, reports its stroke or its timeout, and moves on to the next waiting label.
-    pub(super) fn labels_after_tick(
+    /// Bookkeeping after a tick that played `frame` of `segment` (`tick`): announces a new
+    /// label, serves it with the segment already playing if that carries it before its stroke
+    /// (`tables` say which do), reports its stroke or its timeout (`timeout` ticks; 0: never),
+    /// and moves on to the next waiting label.
+    pub(super) fn after_tick<T: PolicyTables + ?Sized>(
         &mut self,
-        tick: u64,
-        segment: usize,
-        frame: usize,
+        tables: &T,
+        (tick, segment, frame): (u64, usize, usize),
+        timeout: u64,
         sink: &mut impl FnMut(ControllerEvent<'_>),
     ) {
-        let Some(mut a) = self.active_label else {
+        let Some(mut a) = self.active else {
             return;
         };
         let label = a.label as usize;
-        if self.label_received {
-            self.label_received = false;
+        if self.received {
+            self.received = false;
             sink(ControllerEvent::Label {
                 tick: a.since,
                 label,
                 outcome: LabelOutcome::Received,
             });
-            if self.tables.label_of(segment) == a.label + 1 {
-                if let Some(stroke) = self.tables.stroke_of(segment).filter(|&s| s >= frame) {
+            if tables.label_of(segment) == a.label + 1 {
+                if let Some(stroke) = tables.stroke_of(segment).filter(|&s| s >= frame) {
                     a.serving = Some((segment, stroke));
                     sink(ControllerEvent::Label {
                         tick,
@@ -152,7 +161,6 @@ impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'_, T, L> {
             }
             Some(_) => false,
             None => {
-                let timeout = self.ms_ticks(self.label_timeout_ms) as u64;
                 if timeout > 0 && tick.saturating_sub(a.since) >= timeout {
                     sink(ControllerEvent::Label {
                         tick,
@@ -165,11 +173,12 @@ impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'_, T, L> {
                 }
             }
         };
-        self.active_label = Some(a);
+        self.active = Some(a);
         if done {
-            self.active_label = None;
-            if let Some(next) = self.label_queue.pop_front() {
-                self.activate(next);
+            self.active = None;
+            if let Some(next) = self.queue.pop_front() {
+                // It is active from the next tick on.
+                self.activate(next, tick.saturating_add(1));
             }
         }
     }

@@ -61,8 +61,8 @@
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
 mod event;
+mod from_blob;
 mod labels;
-mod timing;
 
 use crate::blob::Blob;
 use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
@@ -75,10 +75,10 @@ use crate::policy::{
     Variety, Visit,
 };
 
+pub use crate::policy::{DecisionTiming, MAX_LABELLED, MAX_LABELS};
 pub use event::{ControllerError, ControllerEvent, LabelOutcome};
-use labels::ActiveLabel;
-pub use labels::{LabelError, LABEL_QUEUE, MAX_LABELLED, MAX_LABELS};
-pub use timing::DecisionTiming;
+use labels::Labels;
+pub use labels::{LabelError, LABEL_QUEUE};
 
 use crate::prosody::{Event, FrontEnd, ProsodyConfig};
 
@@ -93,48 +93,9 @@ struct Deferred {
     at: Option<(usize, usize)>,
 }
 
-/// A controller over a blob's tables: what every host tool and board runs.
+/// A controller over a blob's tables: what every host tool and board runs (built by
+/// [`Controller::from_blob`] or [`Controller::from_blob_in`]).
 pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
-
-impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
-    /// The controller over a validated blob's tables, with the blob's front-end settings and
-    /// decision timing: the one way host tools and boards build a controller.
-    ///
-    /// The controller is about 15 KiB and is copied on the stack on its way out of here; a
-    /// board with little RAM builds it in place with [`from_blob_in`](Self::from_blob_in).
-    pub fn from_blob(blob: &'a Blob<'a>) -> Result<Self, ControllerError> {
-        let mut slot = None;
-        Self::from_blob_in(&mut slot, blob)?;
-        slot.ok_or(ControllerError::Dimensions)
-    }
-
-    /// [`from_blob`](Self::from_blob), built in place in `slot` (on the caller's stack or in
-    /// a `static`) without a temporary copy. On an error `slot` is `None`.
-    pub fn from_blob_in<'s>(
-        slot: &'s mut Option<Self>,
-        blob: &'a Blob<'a>,
-    ) -> Result<&'s mut Self, ControllerError> {
-        let gmm = blob.gmm();
-        let config = blob.prosody_config();
-        let me = Self::new_in(
-            slot,
-            &config,
-            gmm.as_slice(),
-            blob.crf_weights(),
-            blob,
-            blob,
-        )?;
-        me.timing = blob.timing();
-        me.variety = blob.variety();
-        me.label_timeout_ms = blob.label_timeout_ms();
-        me.set_follow(blob.follow());
-        let blend = me.ms_ticks(blob.blend_ms());
-        me.player.set_blend_ticks(blend);
-        me.player
-            .set_speed_cap(crate::player::library_speed_cap(blob));
-        Ok(me)
-    }
-}
 
 /// The whole on-device controller over validated tables `T` (policy) and `L` (library).
 pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
@@ -160,10 +121,7 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     /// The user's tone weights (neutral by default).
     style: Style,
     /// The label being served, and those waiting behind it.
-    active_label: Option<ActiveLabel>,
-    label_queue: heapless::Deque<u8, LABEL_QUEUE>,
-    /// A label became active and its `Received` event is still to be reported.
-    label_received: bool,
+    labels: Labels,
     /// A label not served within this long is dropped (ms; 0: never).
     label_timeout_ms: u32,
     /// Belief the policy decides with instead of the CRF's (an evaluation's ablation).
@@ -237,9 +195,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             variety: Variety::NONE,
             history: History::new(),
             style: Style::NEUTRAL,
-            active_label: None,
-            label_queue: heapless::Deque::new(),
-            label_received: false,
+            labels: Labels::default(),
             label_timeout_ms: 0,
             held_belief: None,
             holding: 0,
@@ -360,6 +316,26 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         &self.style
     }
 
+    /// Asks for the semantic label `label` (0-based, the blob's order; docs/method.md
+    /// "Semantic labels"): from the next exit point on, the controller prefers the segments
+    /// carrying it and may enter one just before its stroke; the label is served once that
+    /// stroke plays, or dropped after the blob's timeout. A label that arrives while another
+    /// is served waits (at most [`LABEL_QUEUE`]). Reports `Received` through the next call's
+    /// events.
+    pub fn push_label(&mut self, label: usize) -> Result<(), LabelError> {
+        self.labels.push(label, self.tables.labels(), self.ticks)
+    }
+
+    /// Drops the label being served and every waiting one.
+    pub fn clear_labels(&mut self) {
+        self.labels.clear();
+    }
+
+    /// The label being served (0-based), if any.
+    pub fn active_label(&self) -> Option<usize> {
+        self.labels.active()
+    }
+
     /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
     pub fn set_timing(&mut self, timing: DecisionTiming) {
         self.timing = timing;
@@ -465,7 +441,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         let segment = self.player.segment();
         let t = self.timing;
         let fresh = !t.sync_to_onsets
-            || self.label_waiting()
+            || self.labels.waiting().is_some()
             || self.last_onset.is_some_and(|o| {
                 !self.ticks_reach_ms(self.ticks.saturating_sub(o), t.onset_window_ms)
             });
@@ -508,7 +484,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             segment,
             frame: played,
         });
-        self.labels_after_tick(tick, segment, played, sink);
+        let timeout = self.ms_ticks(self.label_timeout_ms) as u64;
+        self.labels
+            .after_tick(self.tables, (tick, segment, played), timeout, sink);
         if self.follow_voice(segment, tick, sink) {
             return;
         }
@@ -534,7 +512,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         // A waiting label decides at the next exit point, onset or not; so does every exit
         // point while resting (no onset is coming).
         let fresh = !t.sync_to_onsets
-            || self.label_waiting()
+            || self.labels.waiting().is_some()
             || self.voice.resting()
             || self
                 .last_onset
@@ -670,7 +648,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
         let Some(change) = self.voice.take_change() else {
             return false;
         };
-        if self.label_waiting() || (change == VoiceChange::Rest && self.rest.contains(segment)) {
+        if self.labels.waiting().is_some()
+            || (change == VoiceChange::Rest && self.rest.contains(segment))
+        {
             return false;
         }
         // A cut still waiting for the hands was decided for the speech: decide again.
@@ -725,9 +705,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
             Some(h) => &h[..s],
             None => self.belief(),
         };
-        let waiting = self.active_label.filter(|a| a.serving.is_none());
+        let waiting = self.labels.waiting();
         let decision = match waiting {
-            Some(a) => select_labelled(self.tables, e, b, &penalties, a.label as usize),
+            Some(w) => select_labelled(self.tables, e, b, &penalties, w as usize),
             None => select_styled(self.tables, e, b, &penalties, &self.style),
         };
         match decision.choice {
@@ -741,14 +721,13 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, 
                 // goes on without a cut; anything else (or no run-on) is a cut.
                 let ran_on = self.player.segment() != self.tables.exit_segment(e);
                 let seamless = ran_on && c == self.player.segment() && decision.entry_frame == 0;
-                if let Some(mut a) = waiting {
-                    if self.tables.label_of(c) == a.label + 1 {
+                if let Some(w) = waiting {
+                    if self.tables.label_of(c) == w + 1 {
                         if let Some(stroke) = self.tables.stroke_of(c) {
-                            a.serving = Some((c, stroke));
-                            self.active_label = Some(a);
+                            self.labels.serve(c, stroke);
                             sink(ControllerEvent::Label {
                                 tick,
-                                label: a.label as usize,
+                                label: w as usize,
                                 outcome: LabelOutcome::Entered {
                                     segment: c,
                                     frame: decision.entry_frame,

@@ -44,9 +44,11 @@
 
 mod style;
 mod tables;
+mod timing;
 
 pub use style::{Style, StyleError, MAX_TONES};
-pub use tables::PolicyTables;
+pub use tables::{PolicyTables, MAX_LABELLED, MAX_LABELS};
+pub use timing::DecisionTiming;
 
 use heapless::HistoryBuffer;
 

@@ -1,6 +1,11 @@
 //! The policy tables as the selector reads them ([`PolicyTables`]): value tables, successor
 //! lists and costs, tones, labels and energies of a validated blob.
 
+/// Most semantic labels a blob defines.
+pub const MAX_LABELS: usize = 16;
+/// Most segments of a blob that carry a label.
+pub const MAX_LABELLED: usize = 64;
+
 /// The policy tables as the selector needs them. Implementations must only be built from
 /// validated data: every method is called with indices in range.
 pub trait PolicyTables {

@@ -30,9 +30,9 @@ pub use tables::{
 use crate::blob::header::Header;
 use crate::blob::payload::*;
 use crate::blob::view::Blob;
-use crate::controller::DecisionTiming;
 use crate::follow::VoiceFollow;
 use crate::inference::GmmComponent;
+use crate::policy::DecisionTiming;
 use crate::policy::Variety;
 use crate::prosody::ProsodyConfig;
 use crate::rig::ChannelCal;

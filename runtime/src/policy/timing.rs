@@ -1,8 +1,9 @@
 //! When the controller decides at exit points: on syllable onsets or at once, how long it waits
 //! for one, and how far a cut decided mid-segment looks ahead for the hands' next pause
-//! (the controller's module docs tell the rules).
+//! (the rules are in [`crate::controller`]'s module docs).
 
-/// When the controller decides at exit points (see the module docs).
+/// When the controller decides at exit points (the rules are in [`crate::controller`]'s module
+/// docs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DecisionTiming {
     /// Whether decisions wait for syllable onsets; `false` decides at every exit at once.
