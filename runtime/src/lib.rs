@@ -54,6 +54,7 @@ pub mod controller;
 pub mod device;
 pub mod follow;
 pub mod inference;
+pub mod mic;
 #[cfg(feature = "pca9685")]
 pub mod pca9685;
 pub mod player;

@@ -4,6 +4,8 @@
 
 use core::cell::RefCell;
 
+use gesture_runtime::mic::{adc12_sample, DoubleBuffer};
+
 use cortex_m::interrupt::Mutex;
 use stm32f4xx_hal::adc::config::{AdcConfig, Clock, SampleTime};
 use stm32f4xx_hal::adc::Adc;
@@ -25,49 +27,8 @@ struct Mic {
     timer: CounterHz<TIM2>,
 }
 
-/// The double buffer between the sampling interrupt and the main loop.
-struct Buffers {
-    data: [[i16; CHUNK]; 2],
-    /// The half being filled.
-    filling: usize,
-    pos: usize,
-    /// A full half waiting for the main loop.
-    ready: Option<usize>,
-    overruns: u32,
-}
-
-impl Buffers {
-    const fn new() -> Self {
-        Self {
-            data: [[0; CHUNK]; 2],
-            filling: 0,
-            pos: 0,
-            ready: None,
-            overruns: 0,
-        }
-    }
-
-    fn push(&mut self, s: i16) {
-        self.data[self.filling][self.pos] = s;
-        self.pos += 1;
-        if self.pos == CHUNK {
-            if self.ready.is_some() {
-                // The main loop is late: the older buffer is dropped.
-                self.overruns = self.overruns.wrapping_add(1);
-            }
-            self.ready = Some(self.filling);
-            self.filling ^= 1;
-            self.pos = 0;
-        }
-    }
-
-    fn take(&mut self) -> Option<[i16; CHUNK]> {
-        self.ready.take().map(|half| self.data[half])
-    }
-}
-
 static MIC: Mutex<RefCell<Option<Mic>>> = Mutex::new(RefCell::new(None));
-static BUFFERS: Mutex<RefCell<Buffers>> = Mutex::new(RefCell::new(Buffers::new()));
+static BUFFERS: Mutex<RefCell<DoubleBuffer<CHUNK>>> = Mutex::new(RefCell::new(DoubleBuffer::new()));
 
 #[interrupt]
 fn TIM2() {
@@ -80,8 +41,7 @@ fn TIM2() {
     };
     let _ = mic.timer.wait();
     // 12 bits around the module's half-supply bias, to full-scale i16.
-    let raw = mic.adc.convert(&mic.pin, SampleTime::Cycles_28) as i32;
-    let s = ((raw - 2048) << 4).clamp(i16::MIN as i32, i16::MAX as i32) as i16;
+    let s = adc12_sample(mic.adc.convert(&mic.pin, SampleTime::Cycles_28));
     cortex_m::interrupt::free(|cs| BUFFERS.borrow(cs).borrow_mut().push(s));
 }
 
@@ -111,6 +71,6 @@ pub fn start<M: stm32f4xx_hal::gpio::PinMode>(
 pub fn take() -> (Option<[i16; CHUNK]>, u32) {
     cortex_m::interrupt::free(|cs| {
         let mut b = BUFFERS.borrow(cs).borrow_mut();
-        (b.take(), b.overruns)
+        (b.take(), b.overruns())
     })
 }
