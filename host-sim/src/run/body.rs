@@ -24,7 +24,7 @@ use gesture_trainer::motion::effectors::{find_hand, Side};
 use gesture_trainer::motion::fk::{Target, Vec3};
 use gesture_trainer::motion::Skeleton;
 
-use super::preview::Canvas;
+use super::canvas::Canvas;
 
 /// First palette index of the body's shading ramp (dark to light).
 pub(super) const SHADE0: u8 = 80;

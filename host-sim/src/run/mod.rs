@@ -32,6 +32,7 @@
 
 pub mod blender;
 pub mod body;
+mod canvas;
 pub mod preview;
 pub mod servos;
 pub mod sim;

@@ -11,7 +11,7 @@ use gesture_runtime::blob::Blob;
 use gesture_runtime::rig::ChannelCal;
 use serde::Serialize;
 
-use super::preview::{Canvas, GRID, INK};
+use super::canvas::{Canvas, GRID, INK};
 use crate::servo::MAX_DUTY;
 
 /// The name of the rig `pack` makes without a rig file.

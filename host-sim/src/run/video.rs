@@ -20,7 +20,8 @@ use std::process::{Command, Stdio};
 
 use gesture_trainer::rig::PoseSkeleton;
 
-use super::preview::{palette, Canvas, Figure, Plot, BG, INK, PANEL, RED};
+use super::canvas::{Canvas, BG, INK, PANEL, RED};
+use super::preview::{palette, Figure, Plot};
 use super::servos::ServoBars;
 use super::sim::Simulation;
 
