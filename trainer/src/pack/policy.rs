@@ -3,7 +3,8 @@
 //! labels' value tables (`styles`, `labels`). With a byte budget, the successor lists are cut
 //! to the largest number per exit point (`k`, the best by cost under the state prior) whose
 //! blob, encoded with the sections of stage 2, fits; bisection over `k`, since the size grows
-//! with it. Without a budget, `--max-successors` bounds them as the control layer kept them.
+//! with it, up to `--max-successors` when that is given (the budget only ever cuts further).
+//! Without a budget, `--max-successors` bounds them as the control layer kept them.
 //! The cut is lossy; the report (stage 6) measures its regret.
 
 use gesture_runtime::blob::encode::{
@@ -52,7 +53,7 @@ impl PolicySections {
                     .and_then(|p| sections.encode(&p, styles.as_ref(), labels.as_ref()))
                     .map_or(usize::MAX, |b| b.len())
             };
-            k = fit_budget(model, cm, budget, &size);
+            k = fit_budget(model, cm, budget, opts.control.max_successors, &size);
             if k.is_none() {
                 return Err(PackError::Budget {
                     budget,
@@ -177,17 +178,23 @@ pub fn labels_section(
     .map(Some)
 }
 
-/// Truncates `cm` to the largest number of successors per exit whose blob fits `budget`
-/// bytes, as measured by `size(kept)`; returns that number (`None` if even one successor per
-/// exit does not fit). Bisection over `k`, since the size grows with `k`.
+/// Truncates `cm` to the largest number of successors per exit, at most `cap`, whose blob fits
+/// `budget` bytes, as measured by `size(kept)`; returns that number (`None` if even one
+/// successor per exit does not fit). Bisection over `k`, since the size grows with `k`.
 fn fit_budget(
     model: &InferenceModel,
     cm: &mut ControlModel,
     budget: usize,
+    cap: Option<usize>,
     size: &dyn Fn(&ControlModel) -> usize,
 ) -> Option<usize> {
-    let max_k = cm.pruned.iter().map(Vec::len).max().unwrap_or(1).max(1);
-    cm.kept = cm.pruned.clone();
+    let most = cm.pruned.iter().map(Vec::len).max().unwrap_or(1).max(1);
+    let max_k = cap.map_or(most, |m| m.clamp(1, most));
+    cm.kept = if max_k < most {
+        keep_best(&cm.policy, &cm.pruned, &model.state_prior, max_k)
+    } else {
+        cm.pruned.clone()
+    };
     if size(cm) <= budget {
         return Some(max_k);
     }
