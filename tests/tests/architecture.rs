@@ -20,8 +20,8 @@ const MAX_LINES: usize = 800;
 /// simulator's bodies and its ROS 2 output) and are untangled there: each a set of files a reported circle may
 /// lie in. Each is a debt, not a permission: `blob` reads the label capacities and the
 /// decision timing from `controller`, and the preview's
-/// canvas is shared with the bodies and servo bars it draws, and the DDS publisher uses the
-/// ROS 2 module's types, and `run` writes the URDF whose command reads `run`'s blob and rig.
+/// canvas is shared with the bodies and servo bars it draws, and `run` writes the URDF whose
+/// command reads `run`'s blob and rig.
 const OPEN_CIRCLES: &[&[&str]] = &[
     &[
         "runtime/src/blob/error.rs",
@@ -29,7 +29,6 @@ const OPEN_CIRCLES: &[&[&str]] = &[
         "runtime/src/controller/mod.rs",
     ],
     &["host-sim/src/run/body.rs", "host-sim/src/run/preview.rs"],
-    &["host-sim/src/ros2/dds.rs", "host-sim/src/ros2/mod.rs"],
     &["host-sim/src/ros2/urdf.rs", "host-sim/src/run/mod.rs"],
 ];
 

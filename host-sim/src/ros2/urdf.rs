@@ -48,7 +48,7 @@ use gesture_runtime::rotation::{
 use gesture_trainer::motion::fk::local_transform;
 use gesture_trainer::rig::PoseSkeleton;
 
-use super::Ros2Error;
+use super::error::Ros2Error;
 use crate::run::{calibrations, read_blob, RunError};
 
 /// Metres per BVH unit (BVH units taken as centimetres).
