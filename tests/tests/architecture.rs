@@ -17,11 +17,10 @@ use std::path::{Path, PathBuf};
 const MAX_LINES: usize = 800;
 
 /// Circles that came with parallel work (the controller's, policy's and player's split, the
-/// simulator's bodies and its ROS 2 output) and are untangled there: each a set of files a reported circle may
+/// simulator's bodies) and are untangled there: each a set of files a reported circle may
 /// lie in. Each is a debt, not a permission: `blob` reads the label capacities and the
-/// decision timing from `controller`, and the preview's
-/// canvas is shared with the bodies and servo bars it draws, and `run` writes the URDF whose
-/// command reads `run`'s blob and rig.
+/// decision timing from `controller`, and the preview's canvas is shared with the bodies and
+/// servo bars it draws.
 const OPEN_CIRCLES: &[&[&str]] = &[
     &[
         "runtime/src/blob/error.rs",
@@ -29,7 +28,6 @@ const OPEN_CIRCLES: &[&[&str]] = &[
         "runtime/src/controller/mod.rs",
     ],
     &["host-sim/src/run/body.rs", "host-sim/src/run/preview.rs"],
-    &["host-sim/src/ros2/urdf.rs", "host-sim/src/run/mod.rs"],
 ];
 
 /// The crates whose sources are checked, as folders under the repository root.
