@@ -314,8 +314,9 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             blob,
             rig,
             out: file,
-        } => crate::ros2::urdf::run(blob, rig.as_deref(), file.as_deref(), out)
-            .map_err(SimError::from),
+        } => {
+            crate::urdf_cmd::run(blob, rig.as_deref(), file.as_deref(), out).map_err(SimError::from)
+        }
         Command::Demo { out: dir, audio } => Ok(crate::demo::demo(
             dir,
             crate::demo::DemoParams::default(),

@@ -27,7 +27,8 @@
 //!   limits, memory).
 //! - [`vmc`]: the played poses to avatar apps over the VMC protocol (OSC over UDP).
 //! - [`ros2`]: robots through ROS 2: `sensor_msgs/JointState` over DDS (`--ros2`, feature
-//!   `ros2`), in an MCAP file (`--mcap`), and the character as a URDF (`gesture-sim urdf`).
+//!   `ros2`), in an MCAP file (`--mcap`), and the character as a URDF.
+//! - [`urdf_cmd`]: `gesture-sim urdf`: that URDF written alone.
 //! - [`style`]: `--style`, `--energy`, `--style-track`: the tone weights of a run.
 //! - [`labels`]: `--labels`: semantic labels at audio times.
 //! - [`kws`]: `--keywords`: keyword spotting with CMU PocketSphinx (feature `kws`), the only
@@ -51,4 +52,5 @@ pub mod run;
 pub mod servo;
 pub mod soak;
 pub mod style;
+pub mod urdf_cmd;
 pub mod vmc;

@@ -13,12 +13,13 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::{run_into, setup, text, workspace};
-use gesture_runtime::blob::Blob;
+use gesture_runtime::blob::{Blob, DriveMode};
 use gesture_runtime::rig::ChannelCal;
-use gesture_trainer::motion::fk::world_pose;
-use gesture_trainer::motion::read_bvh;
-use gesture_trainer::rig::PoseSkeleton;
-use host_sim::ros2::urdf::{Robot, SCALE};
+use gesture_runtime::rotation::{mat_mul, mat_vec, transpose, Mat3};
+use gesture_trainer::motion::fk::{world_pose, world_transforms, Transform};
+use gesture_trainer::motion::{read_bvh, Skeleton};
+use gesture_trainer::rig::{Body, BodyMeasure, Effector, PoseSkeleton};
+use host_sim::ros2::urdf::{Motion, Robot, SCALE};
 use serde_json::Value;
 
 fn script(name: &str) -> PathBuf {
@@ -199,21 +200,13 @@ fn mcap_and_urdf_of_a_run_open_in_ros_tools() {
     assert!(worst < 1e-6, "worst joint position error {worst} m");
 }
 
-/// The puppet's URDF: the rig's eight channels as revolute joints with the calibration's
-/// limits (parsed by urdf-parser-py), and, computed here as robot_state_publisher would, every
-/// joint where the simulator's skeleton puts it for poses across the limits.
+/// The joint-rotation puppet's URDF: the rig's eight channels as revolute joints with the
+/// calibration's limits (parsed by urdf-parser-py), and, computed here as robot_state_publisher
+/// would, every joint where the simulator's skeleton puts it for poses across the limits.
 #[test]
 fn puppet_urdf_has_the_rigs_joints_and_limits() {
     let s = setup();
-    // The shipped rig's channels are body measures, which a URDF cannot show (refused, with
-    // the reason); the same puppet in joint-rotation form can.
-    let shipped_bytes = std::fs::read(&s.puppet).unwrap();
-    let shipped = Blob::parse(&shipped_bytes).unwrap();
-    let cals0: Vec<ChannelCal> = (0..shipped.channels())
-        .map(|c| shipped.calibration(c).unwrap())
-        .collect();
-    let refused = Robot::from_blob(&shipped, &cals0).unwrap_err().to_string();
-    assert!(refused.contains("is a body measure"), "{refused}");
+    // The puppet in joint-rotation form (the shipped rig reads body measures; see below).
     let joints_blob = s.root.join("puppet-joints.blob");
     let opts = gesture_trainer::pack::PackOptions {
         rig: Some(workspace().join("host-sim/tests/data/puppet-8ch-joints.toml")),
@@ -309,6 +302,312 @@ fn puppet_urdf_has_the_rigs_joints_and_limits() {
         );
         assert!(close(&lim[2], cals[c].max_slew_deg_per_s), "{j}");
     }
+}
+
+/// ROS axes from BVH axes (`ros = M bvh`), as the URDF's `base_link` turns them.
+const ROS_FROM_BVH: Mat3 = [[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+/// The skeleton's world transforms (BVH axes and units) from a URDF's link frames in
+/// `base_link` (ROS axes, metres), each BVH joint's link named as the joint.
+fn bvh_world(sk: &Skeleton, link: impl Fn(&str) -> (Mat3, [f64; 3])) -> Vec<Transform> {
+    let back = transpose(&ROS_FROM_BVH);
+    sk.joints
+        .iter()
+        .map(|j| {
+            let (r, p) = link(&j.name);
+            Transform {
+                rotation: mat_mul(&back, &r),
+                position: mat_vec(&back, &p).map(|v| v / SCALE),
+            }
+        })
+        .collect()
+}
+
+/// What the body channels of a frame show: each channel's body measure (deg), each upper
+/// arm's unit direction in body axes, and the head's rotation relative to the chest in body
+/// axes (`Aᵀ R_chestᵀ R_head A`).
+struct Shown {
+    measures: Vec<f64>,
+    arms: [[f64; 3]; 2],
+    head: Mat3,
+}
+
+fn shown(ps: &PoseSkeleton, measures: &[BodyMeasure], world: &[Transform]) -> Shown {
+    let sk = ps.skeleton();
+    let body = ps.body();
+    let axes = ps.body_axes().expect("a body frame");
+    let chest = world[body.chest.unwrap()].rotation;
+    let frame = mat_mul(&chest, &axes);
+    let arm = |s: usize| {
+        let a = body.arms[s].unwrap();
+        let p = Body::point(sk, world, Effector::Joint(a.upper)).unwrap();
+        let q = Body::point(sk, world, a.elbow).unwrap();
+        let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+        let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        mat_vec(&transpose(&frame), &d.map(|v| v / n))
+    };
+    let head = world[body.head.unwrap()].rotation;
+    Shown {
+        measures: measures
+            .iter()
+            .map(|&m| body.measure(sk, world, &axes, m).unwrap())
+            .collect(),
+        arms: [arm(0), arm(1)],
+        head: mat_mul(
+            &transpose(&frame),
+            &mat_mul(&transpose(&chest), &mat_mul(&head, &axes)),
+        ),
+    }
+}
+
+/// The largest difference of the arm directions and head rotations of two frames.
+fn shown_gap(a: &Shown, b: &Shown) -> f64 {
+    let arms = a.arms.iter().flatten().zip(b.arms.iter().flatten());
+    let head = a.head.iter().flatten().zip(b.head.iter().flatten());
+    arms.chain(head)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// The body measure each channel of `blob` reads (all of them must be body channels).
+fn body_measures(blob: &Blob<'_>) -> Vec<BodyMeasure> {
+    let v = blob.skeleton().unwrap();
+    (0..v.drives())
+        .map(|c| match v.drive(c).unwrap().mode {
+            DriveMode::Body(k) => BodyMeasure::from_index(k).unwrap(),
+            m => panic!("channel {c} is not a body measure: {m:?}"),
+        })
+        .collect()
+}
+
+/// The shipped puppet rig reads body measures: its URDF has the eight channels as revolute
+/// joints with the calibration's limits, and its forward kinematics (computed here as
+/// robot_state_publisher would) show every channel's value exactly, for poses across the
+/// limits: each measure read back from the URDF's links equals the pose's value, and the arm
+/// directions, head rotation and elbow flexes equal those of the simulator's skeleton.
+#[test]
+fn body_puppet_urdf_shows_the_measures_exactly() {
+    let s = setup();
+    let bytes = std::fs::read(&s.puppet).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let cals: Vec<ChannelCal> = (0..blob.channels())
+        .map(|c| blob.calibration(c).unwrap())
+        .collect();
+    let robot = Robot::from_blob(&blob, &cals).unwrap();
+    let names: Vec<&str> = blob.channel_names().collect();
+    assert_eq!(robot.movable(), names);
+    assert!(robot.approximate.is_empty());
+    for j in &robot.joints {
+        if let Motion::Turn {
+            channel, limits, ..
+        } = j.motion
+        {
+            let k = &cals[channel];
+            let want =
+                [k.min_deg, k.max_deg, k.max_slew_deg_per_s].map(|d| (d as f64).to_radians());
+            let (lo, hi, v) = limits.expect("revolute");
+            assert!(
+                (lo - want[0]).abs() + (hi - want[1]).abs() + (v - want[2]).abs() < 1e-12,
+                "{}",
+                j.name
+            );
+        }
+    }
+    let measures = body_measures(&blob);
+    let ps = PoseSkeleton::from_blob(&blob.skeleton().unwrap()).unwrap();
+    let (mut worst_measure, mut worst_shape) = (0.0f64, 0.0f64);
+    let mut poses = 0;
+    // Inside the limits by 5 % of the range, so no arm points straight forward (swing 90,
+    // where raise is undefined).
+    for step in 0..=12 {
+        let x = 0.05 + 0.9 * step as f32 / 12.0;
+        let pose: Vec<f32> = cals
+            .iter()
+            .enumerate()
+            .map(|(c, k)| {
+                let t = if c % 2 == 0 { x } else { 1.0 - x };
+                k.min_deg + t * (k.max_deg - k.min_deg)
+            })
+            .collect();
+        let frames = robot.link_frames(&pose);
+        let urdf = bvh_world(ps.skeleton(), |n| {
+            let f = frames.iter().find(|f| f.0 == n).unwrap();
+            (f.1, f.2)
+        });
+        let urdf = shown(&ps, &measures, &urdf);
+        let sim = shown(
+            &ps,
+            &measures,
+            &world_transforms(ps.skeleton(), &ps.frame(&pose)),
+        );
+        for (c, &want) in pose.iter().enumerate() {
+            let want = want as f64;
+            worst_measure = worst_measure
+                .max((urdf.measures[c] - want).abs())
+                .max((sim.measures[c] - want).abs());
+        }
+        worst_shape = worst_shape.max(shown_gap(&urdf, &sim));
+        poses += 1;
+    }
+    eprintln!(
+        "body puppet urdf, {poses} poses across the limits: measures within {worst_measure:.1e} \
+         deg of the pose, arm directions and head rotation within {worst_shape:.1e} of the \
+         simulator's"
+    );
+    assert!(worst_measure < 1e-6, "{worst_measure} deg");
+    assert!(worst_shape < 1e-6, "{worst_shape}");
+}
+
+/// A body measure is a fixed chain only if nothing inside it turns: a channel on the left
+/// clavicle, between the chest and the upper arm whose raise and swing the rig reads, is
+/// refused, naming the channel and the joint.
+#[test]
+fn body_urdf_refuses_a_turning_joint_inside_a_measure() {
+    let s = setup();
+    let rig = std::fs::read_to_string(workspace().join("rigs/puppet-8ch.toml")).unwrap();
+    let rig = format!(
+        "{rig}\n[[channel]]\nname = \"left_clavicle\"\njoint = [\"LeftShoulder\"]\naxis = \"Z\"\n\
+         neutral_deg = 0.0\nmin_deg = -20.0\nmax_deg = 20.0\ndirection = 1\n\
+         pulse_neutral_us = 1500\nus_per_deg = 10.0\nmax_slew_deg_per_s = 200.0\n"
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let rig_path = tmp.path().join("clavicle.toml");
+    std::fs::write(&rig_path, rig).unwrap();
+    let blob_path = tmp.path().join("clavicle.blob");
+    let opts = gesture_trainer::pack::PackOptions {
+        rig: Some(rig_path),
+        ..gesture_trainer::pack::PackOptions::default()
+    };
+    gesture_trainer::pack::pack(
+        &s.root.join("model.json"),
+        std::slice::from_ref(&s.corpus),
+        &opts,
+        &blob_path,
+    )
+    .unwrap();
+    let bytes = std::fs::read(&blob_path).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let cals: Vec<ChannelCal> = (0..blob.channels())
+        .map(|c| blob.calibration(c).unwrap())
+        .collect();
+    let e = Robot::from_blob(&blob, &cals).unwrap_err().to_string();
+    assert!(
+        e.contains("channel `left_clavicle` moves joint \"LeftShoulder\""),
+        "{e}"
+    );
+}
+
+/// A run of the shipped puppet, through the URDF the run wrote, read by ROS tools
+/// (urdf-parser-py, forward kinematics as robot_state_publisher computes it): with the body
+/// measures of the run's motion.bvh (the played poses) as positions, the URDF shows
+/// motion.bvh's arm directions and head rotation within 1e-6 and every measure (the elbow
+/// flexes too) within 1e-6 rad, on every frame; with the positions of the run's MCAP file
+/// (rosbags; what the servos are commanded, which trail the played pose by the slew limit),
+/// it shows those positions within 1e-6 rad.
+#[test]
+fn body_puppet_run_urdf_shows_motion_bvh() {
+    let test = "body_puppet_run_urdf_shows_motion_bvh";
+    let Some(python) = e2e_tests::ros2_python(test) else {
+        return;
+    };
+    let s = setup();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    let mcap = tmp.path().join("run.mcap");
+    let o = run_into(
+        &s.puppet,
+        &s.wav,
+        &dir,
+        &["--no-video", "--mcap", mcap.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("robot.urdf ("),
+        "{}",
+        text(&o.stdout)
+    );
+    let bytes = std::fs::read(&s.puppet).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let measures = body_measures(&blob);
+    let ps = PoseSkeleton::from_blob(&blob.skeleton().unwrap()).unwrap();
+    let m = read_bvh(dir.join("motion.bvh")).unwrap();
+    let n = m.frames();
+    let bvh: Vec<Shown> = (0..n)
+        .map(|f| shown(&ps, &measures, &world_pose(&m, f).unwrap()))
+        .collect();
+
+    let v = python_json(&python, &[&script("read_mcap.py"), &mcap]);
+    let msgs = v["rosbags"].as_array().unwrap();
+    assert_eq!(msgs.len(), n, "messages against motion.bvh's frames");
+    let num = |v: &Value| v.as_f64().unwrap();
+    let sent: Vec<Vec<f64>> = msgs
+        .iter()
+        .map(|m| m["position"].as_array().unwrap().iter().map(num).collect())
+        .collect();
+    let played: Vec<Vec<f64>> = bvh
+        .iter()
+        .map(|b| b.measures.iter().map(|d| d.to_radians()).collect())
+        .collect();
+    // Frames 0..n: motion.bvh's measures; n..2n: the messages' positions.
+    let positions = tmp.path().join("positions.json");
+    let all: Vec<&Vec<f64>> = played.iter().chain(&sent).collect();
+    std::fs::write(
+        &positions,
+        serde_json::json!({"name": msgs[0]["name"], "frames": all}).to_string(),
+    )
+    .unwrap();
+    let u = python_json(
+        &python,
+        &[&script("read_urdf.py"), &dir.join("robot.urdf"), &positions],
+    );
+    let movable = u["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|j| j["type"] != "fixed")
+        .count();
+    assert_eq!(movable, measures.len());
+    let urdf = |f: usize| {
+        let world = bvh_world(ps.skeleton(), |name| {
+            let r = &u["fk_rot"][f][name];
+            let p = &u["fk"][f][name];
+            (
+                [0, 1, 2].map(|i| [0, 1, 2].map(|k| num(&r[i][k]))),
+                [0, 1, 2].map(|i| num(&p[i])),
+            )
+        });
+        shown(&ps, &measures, &world)
+    };
+    let gap = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x.to_radians() - y).abs())
+            .fold(0.0, f64::max)
+    };
+    let (mut worst_played, mut worst_shape, mut worst_sent) = (0.0f64, 0.0f64, 0.0f64);
+    let mut following = 0;
+    for f in 0..n {
+        let shows = urdf(f);
+        worst_played = worst_played.max(gap(&shows.measures, &played[f]));
+        worst_shape = worst_shape.max(shown_gap(&shows, &bvh[f]));
+        worst_sent = worst_sent.max(gap(&urdf(n + f).measures, &sent[f]));
+        if sent[f]
+            .iter()
+            .zip(&played[f])
+            .all(|(a, b)| (a - b).abs() < 1e-4)
+        {
+            following += 1;
+        }
+    }
+    eprintln!(
+        "body puppet run, {n} frames, URDF by urdf-parser-py: with motion.bvh's measures, \
+         measures within {worst_played:.1e} rad and arm directions and head rotation within \
+         {worst_shape:.1e} of motion.bvh's; with the MCAP's positions, within {worst_sent:.1e} \
+         rad of them (the servos on the played pose within 1e-4 rad on {following} frames)"
+    );
+    assert!(worst_played < 1e-6, "{worst_played} rad");
+    assert!(worst_shape < 1e-6, "{worst_shape}");
+    assert!(worst_sent < 1e-6, "{worst_sent} rad");
 }
 
 /// `urdf` and `run --mcap` refuse bad input with one line and exit 2.

@@ -16,15 +16,6 @@ use std::path::{Path, PathBuf};
 /// The longest a source file may be (STYLE.md 13: past this, the concept has parts).
 const MAX_LINES: usize = 800;
 
-/// Circles that came with parallel work (the simulator's ROS 2 output) and are untangled
-/// there: each a set of files a reported circle may lie in. Each is a debt, not a permission:
-/// the DDS publisher uses the ROS 2 module's types, and `run` writes the URDF whose command
-/// reads `run`'s blob and rig.
-const OPEN_CIRCLES: &[&[&str]] = &[
-    &["host-sim/src/ros2/dds.rs", "host-sim/src/ros2/mod.rs"],
-    &["host-sim/src/ros2/urdf.rs", "host-sim/src/run/mod.rs"],
-];
-
 /// The crates whose sources are checked, as folders under the repository root.
 const CRATES: &[&str] = &[
     "runtime",
@@ -63,12 +54,6 @@ fn no_two_files_import_each_other() {
         let tree = ModuleTree::read(&root.join(c).join("src"));
         for (circle, rest) in tree.circles() {
             let names: Vec<String> = circle.iter().map(|f| relative(&root, f)).collect();
-            if OPEN_CIRCLES
-                .iter()
-                .any(|open| names.iter().all(|n| open.contains(&n.as_str())))
-            {
-                continue;
-            }
             let mut line = names.join(" -> ");
             if !rest.is_empty() {
                 let rest: Vec<String> = rest.iter().map(|f| relative(&root, f)).collect();

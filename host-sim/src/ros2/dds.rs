@@ -1,6 +1,6 @@
 //! The DDS side (feature `ros2`): one participant in the `ROS_DOMAIN_ID` domain, a node
 //! `/gesture_sim` and a `sensor_msgs/msg/JointState` publisher, through `ros2-client` on
-//! RustDDS (pure Rust, no ROS installation). QoS: [`super::QOS`], which matches both
+//! RustDDS (pure Rust, no ROS installation). QoS: [`super::topic::QOS`], which matches both
 //! reliable subscribers (`ros2 topic echo`, rclpy's default) and best-effort ones
 //! (`robot_state_publisher`'s sensor-data profile); samples sent before a subscriber is
 //! discovered are not kept for it (volatile), as with any ROS 2 publisher.
@@ -12,8 +12,9 @@ use ros2_client::{
     Context, ContextOptions, MessageTypeName, Name, Node, NodeName, NodeOptions, QosProfile,
 };
 
+use super::error::Ros2Error;
 use super::msg::JointState;
-use super::{topic_name, Ros2Error};
+use super::topic::{full_topic, topic_name};
 
 /// A running JointState publisher.
 pub struct Publisher {
@@ -58,7 +59,7 @@ impl Publisher {
         let publisher = node
             .create_publisher::<JointState>(&t, None)
             .map_err(|e| start(format!("{e:?}")))?;
-        let full = super::full_topic(Some(topic))?;
+        let full = full_topic(Some(topic))?;
         Ok(Self {
             _node: node,
             _context: context,

@@ -17,11 +17,15 @@
 //! does.
 //!
 //! - [`msg`]: the message types, their definition text and CDR bytes.
+//! - [`Ros2Error`]: why ROS 2 output could not start or go on.
+//! - [`topic_name`], [`domain_id`], [`full_topic`], [`QOS`]: where the messages go and how.
 //! - [`recording`]: the MCAP file.
 //! - [`urdf`]: the character as a URDF, its joints named as the messages name them.
 
+mod error;
 pub mod msg;
 pub mod recording;
+mod topic;
 pub mod urdf;
 
 #[cfg(feature = "ros2")]
@@ -29,115 +33,9 @@ mod dds;
 
 use gesture_runtime::blob::Blob;
 
+pub use error::Ros2Error;
 use msg::{Header, JointState, Time};
-
-/// The default topic (what `robot_state_publisher` subscribes to).
-pub const DEFAULT_TOPIC: &str = "/joint_states";
-
-/// Why ROS 2 output could not start or go on.
-#[derive(Debug, thiserror::Error)]
-pub enum Ros2Error {
-    /// A build without the `ros2` feature was asked for `--ros2`.
-    #[error(
-        "--ros2 needs the `ros2` feature: cargo run --release -p host-sim --features ros2 -- ..."
-    )]
-    NoFeature,
-    /// The topic name is not a ROS 2 topic name.
-    #[error("--ros2-topic {topic:?}: {reason}")]
-    Topic {
-        /// What was given.
-        topic: String,
-        /// What is wrong.
-        reason: String,
-    },
-    /// `ROS_DOMAIN_ID` is set to something that is not a domain.
-    #[error("ROS_DOMAIN_ID={value:?}: not a ROS 2 domain (an integer from 0 to 232; 0-101 are safe on Linux)")]
-    Domain {
-        /// The variable's value.
-        value: String,
-    },
-    /// The DDS participant or publisher could not start.
-    #[error("--ros2: starting DDS: {0}")]
-    Start(String),
-    /// Publishing failed.
-    #[error("--ros2: publishing: {0}")]
-    Publish(String),
-    /// The MCAP file could not be made or written.
-    #[error("{}: {reason}", path.display())]
-    Mcap {
-        /// The file.
-        path: std::path::PathBuf,
-        /// Why.
-        reason: String,
-    },
-    /// The blob's skeleton and channels do not make a URDF.
-    #[error("URDF: {0}")]
-    Urdf(String),
-}
-
-impl Ros2Error {
-    /// Exit status: 2 for bad input, 1 for failures of the network or the file system.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Self::NoFeature | Self::Topic { .. } | Self::Domain { .. } | Self::Urdf(_) => 2,
-            Self::Start(_) | Self::Publish(_) | Self::Mcap { .. } => 1,
-        }
-    }
-}
-
-/// A checked topic name: `(namespace, base name)`, e.g. `("/", "joint_states")` or
-/// `("/robot", "joint_states")`. A relative name is taken from the root namespace (the node
-/// lives there). Tokens are ASCII letters, digits and `_`, not starting with a digit, with
-/// no `__`; `~` and `{}` substitutions are not supported.
-pub fn topic_name(topic: &str) -> Result<(String, String), Ros2Error> {
-    let bad = |reason: &str| Ros2Error::Topic {
-        topic: topic.to_string(),
-        reason: reason.to_string(),
-    };
-    let rel = topic.strip_prefix('/').unwrap_or(topic);
-    if rel.is_empty() {
-        return Err(bad("empty (give a name such as /joint_states)"));
-    }
-    if rel.ends_with('/') {
-        return Err(bad("ends with '/'"));
-    }
-    let tokens: Vec<&str> = rel.split('/').collect();
-    for t in &tokens {
-        if t.is_empty() {
-            return Err(bad("has an empty part ('//')"));
-        }
-        if let Some(c) = t
-            .chars()
-            .find(|c| !(c.is_ascii_alphanumeric() || *c == '_'))
-        {
-            return Err(bad(&format!(
-                "{c:?} is not allowed (letters, digits, '_' and '/' only)"
-            )));
-        }
-        if t.starts_with(|c: char| c.is_ascii_digit()) {
-            return Err(bad("a part starts with a digit"));
-        }
-        if t.contains("__") {
-            return Err(bad("has '__' (reserved)"));
-        }
-    }
-    let (ns, base) = tokens.split_at(tokens.len() - 1);
-    Ok((format!("/{}", ns.join("/")), base[0].to_string()))
-}
-
-/// The DDS domain from `ROS_DOMAIN_ID` (`value`; unset or empty: 0), as ROS 2 reads it.
-pub fn domain_id(value: Option<&str>) -> Result<u16, Ros2Error> {
-    let v = value.map(str::trim).unwrap_or("");
-    if v.is_empty() {
-        return Ok(0);
-    }
-    match v.parse::<u16>() {
-        Ok(d) if d <= 232 => Ok(d),
-        _ => Err(Ros2Error::Domain {
-            value: v.to_string(),
-        }),
-    }
-}
+pub use topic::{domain_id, full_topic, topic_name, DEFAULT_TOPIC, QOS};
 
 /// The messages of one character: its joint names and frame rate (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -204,19 +102,6 @@ pub fn unix_nanos() -> i64 {
         .map_or(0, |d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX))
 }
 
-/// The full name of a checked topic (`/joint_states`, `/robot/joint_states`).
-pub fn full_topic(topic: Option<&str>) -> Result<String, Ros2Error> {
-    let (ns, base) = topic_name(topic.unwrap_or(DEFAULT_TOPIC))?;
-    Ok(if ns == "/" {
-        format!("/{base}")
-    } else {
-        format!("{ns}/{base}")
-    })
-}
-
-/// The QoS of the publisher, as the docs state it.
-pub const QOS: &str = "reliable, volatile, keep last 100";
-
 #[cfg(feature = "ros2")]
 pub use dds::Publisher;
 
@@ -270,29 +155,6 @@ impl Publisher {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn topic_names_are_checked_and_split() {
-        let ok = |t: &str| topic_name(t).unwrap();
-        assert_eq!(ok("/joint_states"), ("/".into(), "joint_states".into()));
-        assert_eq!(ok("joint_states"), ("/".into(), "joint_states".into()));
-        assert_eq!(ok("/robot/arm/js2"), ("/robot/arm".into(), "js2".into()));
-        for bad in ["", "/", "/a/", "//a", "/a b", "/1a", "/a__b", "~/a", "/a.b"] {
-            assert!(topic_name(bad).is_err(), "{bad:?} accepted");
-        }
-    }
-
-    #[test]
-    fn domain_ids_are_read_as_ros_does() {
-        assert_eq!(domain_id(None).unwrap(), 0);
-        assert_eq!(domain_id(Some("")).unwrap(), 0);
-        assert_eq!(domain_id(Some(" 42 ")).unwrap(), 42);
-        assert_eq!(domain_id(Some("232")).unwrap(), 232);
-        for bad in ["233", "-1", "x", "1.5"] {
-            let e = domain_id(Some(bad)).unwrap_err();
-            assert_eq!(e.exit_code(), 2);
-        }
-    }
 
     #[test]
     fn stamps_are_ticks_on_the_audio_clock() {

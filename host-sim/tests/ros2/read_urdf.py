@@ -5,7 +5,8 @@ robot's name, its links, and its joints in file order as {"name", "type", "paren
 With a second argument, a JSON file {"name": [...], "frames": [[...], ...]} of joint
 positions (rad), it also prints "fk": per frame, every link's origin in the root link's frame,
 computed from the parsed joints as robot_state_publisher does (origin, then the rotation about
-the axis), for comparison with the character's own forward kinematics.
+the axis), for comparison with the character's own forward kinematics; and "fk_rot": per
+frame, every link's rotation in the root link's frame (3x3, rows).
 
 Usage: read_urdf.py FILE.urdf [POSITIONS.json]
 """
@@ -35,7 +36,7 @@ def rot_axis(axis, q):
 
 
 def fk(robot, positions):
-    """Every link's origin (root frame) for {joint name: position}."""
+    """Every link's (rotation, origin) in the root frame for {joint name: position}."""
     frames = {robot.get_root(): (np.eye(3), np.zeros(3))}
     pending = list(robot.joints)
     while pending:
@@ -56,7 +57,7 @@ def fk(robot, positions):
         if len(rest) == len(pending):
             raise SystemExit("joints not connected to the root: %s" % [j.name for j in rest])
         pending = rest
-    return {k: list(map(float, v[1])) for k, v in frames.items()}
+    return frames
 
 
 def main():
@@ -88,7 +89,9 @@ def main():
     if len(sys.argv) > 2:
         with open(sys.argv[2]) as f:
             p = json.load(f)
-        out["fk"] = [fk(robot, dict(zip(p["name"], frame))) for frame in p["frames"]]
+        frames = [fk(robot, dict(zip(p["name"], frame))) for frame in p["frames"]]
+        out["fk"] = [{k: list(map(float, v[1])) for k, v in f.items()} for f in frames]
+        out["fk_rot"] = [{k: v[0].tolist() for k, v in f.items()} for f in frames]
     print(json.dumps(out))
 
 

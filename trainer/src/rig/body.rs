@@ -402,7 +402,7 @@ impl Body {
 
 /// Pan (about up), tilt (about left), roll (about forward): body axes are (left, up, forward)
 /// = (0, 1, 2), so this is the Euler order `YXZ`.
-const HEAD_ORDER: [usize; 3] = [1, 0, 2];
+pub const HEAD_ORDER: [usize; 3] = [1, 0, 2];
 
 /// [raise, swing] (degrees) of a unit direction `b` in body axes for side `s` (0 = left):
 /// raise = atan2(up, outward), swing = asin(forward).

@@ -146,7 +146,9 @@ mod pose;
 mod spec;
 
 pub use bind::{BoundChannel, BoundRig};
-pub use body::{Arm, Body, BodyMeasure, BodyPart, Effector};
+pub use body::{
+    axis_angle, shortest_rotation, Arm, Body, BodyMeasure, BodyPart, Effector, HEAD_ORDER,
+};
 pub use pose::PoseSkeleton;
 pub use spec::{parse_order, AngleMode, Axis, JointAlias, Rig, RigChannel, RigError, WIDE_CAL};
 

@@ -114,6 +114,17 @@ impl PoseSkeleton {
         &self.rest
     }
 
+    /// The humanoid parts the body channels read, found as the packer found them.
+    pub fn body(&self) -> &Body {
+        &self.body
+    }
+
+    /// The body frame in the chest's frame (columns left, up, forward), from the rest frame;
+    /// `None` if the skeleton gives none ([`Body::axes`]).
+    pub fn body_axes(&self) -> Option<Mat3> {
+        self.axes
+    }
+
     fn local_rotation(&self, frame: &[f64], j: usize) -> Mat3 {
         let joint = &self.skeleton.joints[j];
         let s = self.starts[j];

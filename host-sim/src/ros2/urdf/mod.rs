@@ -26,6 +26,11 @@
 //!   each twist measured with the earlier ones at zero; this is how such a head is built, but
 //!   the simulator applies each twist to the rotation the previous one left, so the two
 //!   differ slightly away from the rest pose ([`Robot::approximate`] names these joints).
+//! - body channels (a rig's `body` keys: head pan, tilt, roll; arm raise and swing; elbow
+//!   flex): each measure the angle of one revolute joint of a fixed chain at the neck, the
+//!   shoulder or the elbow, built on the body frame of the rest frame (`body.rs` gives the
+//!   chains). Exact for the measures; an upper arm's twist about itself, which no measure
+//!   reads, is the chain's rather than the simulator's least turn.
 //! - joints no channel drives: one fixed joint with the rest frame's rotation.
 //!
 //! A negated axis (`-Y`) becomes the URDF axis `0 -1 0`, so positions are the channel values
@@ -35,10 +40,10 @@
 //! Visuals: a sphere per joint and a cylinder per bone (to each child and end site), so RViz
 //! and Foxglove draw the skeleton. Nothing here panics on a validated blob; a channel layout
 //! a URDF cannot show (a joint driven in two modes, two channels on one axis, a channel-mode
-//! channel the joint lacks) is a [`Ros2Error::Urdf`] naming the channel.
+//! channel the joint lacks, a body measure whose part the skeleton lacks or across a joint
+//! another channel turns) is a [`Ros2Error::Urdf`] naming the channel.
 
 use std::fmt::Write as _;
-use std::path::Path;
 
 use gesture_runtime::blob::{Blob, DriveMode};
 use gesture_runtime::rig::ChannelCal;
@@ -48,8 +53,11 @@ use gesture_runtime::rotation::{
 use gesture_trainer::motion::fk::local_transform;
 use gesture_trainer::rig::PoseSkeleton;
 
-use super::Ros2Error;
-use crate::run::{calibrations, read_blob, RunError};
+mod body;
+mod chain;
+
+use super::error::Ros2Error;
+use chain::Elem;
 
 /// Metres per BVH unit (BVH units taken as centimetres).
 pub const SCALE: f64 = 0.01;
@@ -116,12 +124,6 @@ pub struct Robot {
     pub approximate: Vec<String>,
 }
 
-/// One element of a BVH joint's chain.
-enum Elem {
-    Fixed(Mat3),
-    Turn { axis: [f64; 3], channel: usize },
-}
-
 fn signed_axis(index: usize, negated: bool) -> [f64; 3] {
     let mut a = [0.0; 3];
     a[index.min(2)] = if negated { -1.0 } else { 1.0 };
@@ -161,18 +163,6 @@ impl Robot {
                 names.len()
             )));
         }
-        if let Some(c) = drives
-            .iter()
-            .position(|d| matches!(d.mode, DriveMode::Body(_)))
-        {
-            return Err(err(format!(
-                "channel `{}` is a body measure (a rig `body` key): the simulator shows it by the \
-                 least turn of its bone, which no chain of URDF revolute joints reproduces; pack \
-                 with a rig whose channels name joints (`joint` and `axis`) or the full-skeleton \
-                 rig for a URDF",
-                names[c]
-            )));
-        }
         let values = |j: usize| {
             let n = sk.joints[j].channels.len();
             &rest[starts[j]..starts[j] + n]
@@ -199,7 +189,23 @@ impl Robot {
                 .collect();
             let (l_rest, t_rest) = local(j);
             let mut elems = Vec::new();
-            if !angle.is_empty() {
+            let body_channels = mine
+                .iter()
+                .filter(|&&c| matches!(drives[c].mode, DriveMode::Body(_)))
+                .count();
+            if body_channels > 0 {
+                if body_channels != mine.len() {
+                    return Err(err(format!(
+                        "joint {:?} is driven both by body measures and by other channels ({})",
+                        joint.name,
+                        mine.iter()
+                            .map(|&c| names[c])
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )));
+                }
+                elems = body::chain(&ps, &drives, &names, j, &mine).map_err(err)?;
+            } else if !angle.is_empty() {
                 if angle.len() != mine.len() {
                     return Err(err(format!(
                         "joint {:?} is driven both by its own channels and by angles ({}); \
@@ -506,10 +512,19 @@ impl Robot {
     /// Forward kinematics: every link's origin in `base_link` (m) with the channels at
     /// `angles_deg` (degrees, blob order), as `robot_state_publisher` would compute them.
     pub fn link_positions(&self, angles_deg: &[f32]) -> Vec<(String, [f64; 3])> {
+        self.link_frames(angles_deg)
+            .into_iter()
+            .map(|(name, _, t)| (name, t))
+            .collect()
+    }
+
+    /// Forward kinematics: every link's frame in `base_link`, as (name, rotation, origin in
+    /// m), with the channels at `angles_deg` (degrees, blob order).
+    pub fn link_frames(&self, angles_deg: &[f32]) -> Vec<(String, Mat3, [f64; 3])> {
         let mut frames: std::collections::HashMap<&str, (Mat3, [f64; 3])> =
             std::collections::HashMap::new();
         frames.insert("base_link", (identity(), [0.0; 3]));
-        let mut out = vec![("base_link".to_string(), [0.0; 3])];
+        let mut out = vec![("base_link".to_string(), identity(), [0.0; 3])];
         for j in &self.joints {
             let (pr, pt) = frames
                 .get(j.parent.as_str())
@@ -523,7 +538,7 @@ impl Robot {
                 r = mat_mul(&r, &rotation_about(axis, a));
             }
             frames.insert(j.child.as_str(), (r, t));
-            out.push((j.child.clone(), t));
+            out.push((j.child.clone(), r, t));
         }
         out
     }
@@ -609,49 +624,6 @@ impl Robot {
         let _ = writeln!(s, "</robot>");
         s
     }
-}
-
-/// `gesture-sim urdf`: the URDF of the blob at `blob_path` (joint limits from `rig`'s
-/// calibration when given) to `file`, or to `out` without one.
-pub fn run(
-    blob_path: &Path,
-    rig: Option<&Path>,
-    file: Option<&Path>,
-    out: &mut impl std::io::Write,
-) -> Result<(), RunError> {
-    if let Some(f) = file {
-        let mut inputs = vec![blob_path];
-        inputs.extend(rig);
-        gesture_trainer::output::refuse_inputs(&[f], &inputs).map_err(RunError::from)?;
-    }
-    let bytes = read_blob(blob_path)?;
-    let blob = Blob::parse(&bytes).map_err(|source| RunError::Blob {
-        path: blob_path.to_path_buf(),
-        source,
-    })?;
-    let (cals, _) = calibrations(&blob, blob_path, rig)?;
-    let robot = Robot::from_blob(&blob, &cals)?;
-    let xml = robot.to_xml();
-    match file {
-        None => out.write_all(xml.as_bytes())?,
-        Some(f) => {
-            gesture_trainer::output::write_atomic(f, xml.as_bytes()).map_err(|e| {
-                RunError::Write {
-                    path: e.path,
-                    source: e.source,
-                }
-            })?;
-            writeln!(
-                out,
-                "wrote {} ({} movable joints, {} links{})",
-                f.display(),
-                robot.movable().len(),
-                robot.links.len(),
-                robot.note()
-            )?;
-        }
-    }
-    Ok(())
 }
 
 /// Rotation by `deg` about the unit vector `axis` (Rodrigues).
