@@ -7,6 +7,7 @@ use super::event::{ControllerEvent, LabelOutcome};
 use super::Controller;
 use crate::player::LibraryFrames;
 use crate::policy::PolicyTables;
+use crate::prosody::arith::Arith;
 
 /// Most semantic labels a blob defines.
 pub const MAX_LABELS: usize = 16;
@@ -53,7 +54,7 @@ pub(super) struct ActiveLabel {
     pub(super) serving: Option<(usize, usize)>,
 }
 
-impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'_, T, L> {
+impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'_, T, L, A> {
     /// Asks for the semantic label `label` (0-based, the blob's order; docs/method.md
     /// "Semantic labels"): from the next exit point on, the controller prefers the segments
     /// carrying it and may enter one just before its stroke; the label is served once that

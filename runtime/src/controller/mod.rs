@@ -60,6 +60,7 @@
 //! written where they stay, so construction needs only a few KiB of stack beyond the controller
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
+mod build;
 mod event;
 mod labels;
 mod timing;
@@ -80,6 +81,7 @@ use labels::ActiveLabel;
 pub use labels::{LabelError, LABEL_QUEUE, MAX_LABELLED, MAX_LABELS};
 pub use timing::DecisionTiming;
 
+use crate::prosody::arith::{Arith, DefaultArith};
 use crate::prosody::{Event, FrontEnd, ProsodyConfig};
 
 /// A cut decided and waiting for the hands to pause.
@@ -93,57 +95,24 @@ struct Deferred {
     at: Option<(usize, usize)>,
 }
 
-/// A controller over a blob's tables: what every host tool and board runs.
-pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
+/// A controller over a blob's tables: what every host tool and board runs (`A`: the
+/// front-end's arithmetic, the build's by default).
+pub type BlobController<'a, A = DefaultArith> = Controller<'a, Blob<'a>, Blob<'a>, A>;
 
-impl<'a> Controller<'a, Blob<'a>, Blob<'a>> {
-    /// The controller over a validated blob's tables, with the blob's front-end settings and
-    /// decision timing: the one way host tools and boards build a controller.
-    ///
-    /// The controller is about 15 KiB and is copied on the stack on its way out of here; a
-    /// board with little RAM builds it in place with [`from_blob_in`](Self::from_blob_in).
-    pub fn from_blob(blob: &'a Blob<'a>) -> Result<Self, ControllerError> {
-        let mut slot = None;
-        Self::from_blob_in(&mut slot, blob)?;
-        slot.ok_or(ControllerError::Dimensions)
-    }
-
-    /// [`from_blob`](Self::from_blob), built in place in `slot` (on the caller's stack or in
-    /// a `static`) without a temporary copy. On an error `slot` is `None`.
-    pub fn from_blob_in<'s>(
-        slot: &'s mut Option<Self>,
-        blob: &'a Blob<'a>,
-    ) -> Result<&'s mut Self, ControllerError> {
-        let gmm = blob.gmm();
-        let config = blob.prosody_config();
-        let me = Self::new_in(
-            slot,
-            &config,
-            gmm.as_slice(),
-            blob.crf_weights(),
-            blob,
-            blob,
-        )?;
-        me.timing = blob.timing();
-        me.variety = blob.variety();
-        me.label_timeout_ms = blob.label_timeout_ms();
-        me.set_follow(blob.follow());
-        let blend = me.ms_ticks(blob.blend_ms());
-        me.player.set_blend_ticks(blend);
-        me.player
-            .set_speed_cap(crate::player::library_speed_cap(blob));
-        Ok(me)
-    }
-}
-
-/// The whole on-device controller over validated tables `T` (policy) and `L` (library).
-pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
+/// The whole on-device controller over validated tables `T` (policy) and `L` (library), with
+/// the front-end arithmetic `A` (the build's by default; `prosody::arith`).
+pub struct Controller<
+    'a,
+    T: PolicyTables + ?Sized,
+    L: LibraryFrames + ?Sized,
+    A: Arith = DefaultArith,
+> {
     tables: &'a T,
     lib: &'a L,
     crf: CrfWeights<'a>,
     gmm: [GmmComponent; MAX_CLUSTERS],
     clusters: usize,
-    front_end: FrontEnd,
+    front_end: FrontEnd<A>,
     normalizer: StepNormalizer,
     belief: Belief,
     uniform: [f32; MAX_STATES],
@@ -189,26 +158,9 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     pause_ms: u32,
 }
 
-impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
-    /// A controller at the start of segment 0 with a uniform belief, over tables that need
-    /// not come from a blob (the runtime's tests build small ones by hand). Host tools and
-    /// boards use [`from_blob`](Self::from_blob).
-    pub fn new(
-        config: &ProsodyConfig,
-        gmm: &[GmmComponent],
-        crf: CrfWeights<'a>,
-        tables: &'a T,
-        lib: &'a L,
-    ) -> Result<Self, ControllerError> {
-        let mut slot = None;
-        Self::new_in(&mut slot, config, gmm, crf, tables, lib)?;
-        slot.ok_or(ControllerError::Dimensions)
-    }
-
-    /// The controller [`new`](Self::new) returns, built in place in `slot` (on the caller's
-    /// stack or in a `static`) without a temporary copy: the big parts are written where they
-    /// stay. On an error `slot` is `None`.
-    pub fn new_in<'s>(
+impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'a, T, L, A> {
+    /// [`new_in`](Controller::new_in) with the front-end arithmetic `A`.
+    pub fn new_arith_in<'s>(
         slot: &'s mut Option<Self>,
         config: &ProsodyConfig,
         gmm: &[GmmComponent],
