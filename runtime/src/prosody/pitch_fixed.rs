@@ -18,8 +18,8 @@
 //!    the peak test (`r > voicing_threshold / 2`, a local maximum) compares those integers
 //!    with the threshold times the energy, so nothing is divided per lag;
 //! 5. only at a peak are its three values turned into `f32` and handed to the same candidate
-//!    code as the `f32` analyzer ([`add_peak`]), with the same unvoiced score
-//!    ([`unvoiced_score`]).
+//!    code as the `f32` analyzer (`pitch::add_peak`), with the same unvoiced score
+//!    (`pitch::unvoiced_score`).
 //!
 //! Where it differs from the `f32` analyzer: the window has 15 bits (the `f32` one 24), the
 //! Hann table is rounded to Q15 and the window correction to Q16; the peak threshold is
