@@ -23,6 +23,8 @@
 
 use super::intensity::{bessel_i0, MAX_BLOCKS, MAX_HALF_BLOCKS, SILENT_DB};
 
+/// Highest rate (the front-end's): 16-sample blocks keep a block's square sum below 2^34.
+const MAX_RATE_HZ: u32 = 16_000;
 /// Fractional bits of the window weights.
 const WEIGHT_BITS: u32 = 20;
 
@@ -93,7 +95,7 @@ impl IntensityQ {
 
     /// Sets every field as [`new`](Self::new) would, in place.
     pub(crate) fn configure(&mut self, rate_hz: u32, floor_hz: f32) -> Option<()> {
-        if rate_hz % 1000 != 0 || rate_hz == 0 || rate_hz > super::MAX_RATE_HZ {
+        if rate_hz % 1000 != 0 || rate_hz == 0 || rate_hz > MAX_RATE_HZ {
             return None;
         }
         let half_ms = 3.2e3 / floor_hz as f64;

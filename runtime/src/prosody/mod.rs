@@ -482,6 +482,7 @@ impl<A: Arith> FrontEnd<A> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use arith::{Fixed, Float};
 
     #[test]
     fn rejects_bad_configs() {
@@ -528,5 +529,66 @@ mod tests {
             }
         });
         assert_eq!(frames, 100);
+    }
+
+    fn frames<A: Arith>(x: &[i16]) -> [Option<Frame>; 200] {
+        let mut fe = FrontEnd::<A>::with_arith(&ProsodyConfig::DEFAULT).unwrap();
+        let mut out = [None; 200];
+        let mut sink = |e: Event| {
+            if let Event::Frame(f) = e {
+                if let Some(slot) = out.get_mut(f.index as usize) {
+                    *slot = Some(f);
+                }
+            }
+        };
+        fe.push(x, &mut sink);
+        fe.finish(&mut sink);
+        out
+    }
+
+    #[test]
+    fn fixed_front_end_tracks_the_f32_one_on_a_gliding_tone() {
+        // 1.5 s at 16 kHz: a tone gliding 110 -> 260 Hz at a planted level (-12 dBFS), then
+        // 0.3 s of a faint one (-60 dBFS).
+        let mut x = [0i16; 24_000];
+        let mut phase = 0.0f64;
+        for (i, v) in x.iter_mut().enumerate() {
+            let t = i as f64 / 16_000.0;
+            let (f, amp) = if t < 1.2 {
+                (110.0 + 125.0 * t, 0.25)
+            } else {
+                (200.0, 0.001)
+            };
+            phase += 2.0 * core::f64::consts::PI * f / 16_000.0;
+            *v = libm::round(32767.0 * amp * libm::sin(phase)) as i16;
+        }
+        let (a, b) = (frames::<Float>(&x), frames::<Fixed>(&x));
+        let mut voiced = 0;
+        for k in 10..145 {
+            let (Some(fa), Some(fb)) = (a[k], b[k]) else {
+                panic!("frame {k} missing");
+            };
+            let t = k as f64 * 0.01;
+            if (0.1..1.1).contains(&t) {
+                // The planted pitch, within 0.5 % on both paths, and the paths within 0.1 %.
+                let want = 110.0 + 125.0 * t;
+                let (pa, pb) = (fa.f0_hz.unwrap() as f64, fb.f0_hz.unwrap() as f64);
+                assert!(
+                    (pb - want).abs() < 0.005 * want,
+                    "frame {k}: {pb} vs {want}"
+                );
+                assert!((pa - pb).abs() < 0.001 * pa, "frame {k}: {pa} vs {pb}");
+                // Mean square amp^2 / 2 at full scale 1: 10 log10(0.25^2 / 2 / 4e-10).
+                let level = 10.0 * libm::log10(0.25 * 0.25 / 2.0 / 4.0e-10);
+                assert!((fb.intensity_db as f64 - level).abs() < 0.1, "frame {k}");
+                voiced += 1;
+            }
+            assert_eq!(fa.f0_hz.is_some(), fb.f0_hz.is_some(), "frame {k}");
+            assert!(
+                (fa.intensity_db - fb.intensity_db).abs() < 0.01,
+                "frame {k}"
+            );
+        }
+        assert_eq!(voiced, 100);
     }
 }
