@@ -157,7 +157,7 @@ impl PitchAnalyzerQ {
         let seg = &x[c - period..c + period];
         let sum: i32 = seg.iter().fold(0i32, |a, &v| a.wrapping_add(v));
         let count = 2 * period as i32;
-        let mean = (sum + if sum >= 0 { count / 2 } else { -count / 2 }) / count;
+        let mean = sum.wrapping_add(if sum >= 0 { count / 2 } else { -count / 2 }) / count;
         // Shift until the largest deviation fits 15 bits.
         let largest = x
             .iter()
@@ -176,7 +176,8 @@ impl PitchAnalyzerQ {
             .iter()
             .fold(0u32, |m, &v| m.max(v.unsigned_abs() as u32));
         // In full-scale units, as the f32 analyzer's: quarter LSBs times 2^shift over 2^17.
-        let local_peak = (peak << shift) as f32 * (1.0 / (1u32 << (15 + SAMPLE_BITS)) as f32);
+        let local_peak =
+            peak as f32 * ((1u64 << shift) as f32 / (1u32 << (15 + SAMPLE_BITS)) as f32);
         let p = &self.params;
         let silent;
         (out.score[0], silent) = unvoiced_score(p, self.silent_ratio, local_peak, global);
@@ -307,6 +308,16 @@ mod tests {
         q.analyze(&x[..n], &mut g, &mut c);
         let b = best(&c);
         assert!((c.freq[b] - 200.0).abs() < 2.0, "{}", c.freq[b]);
+        // Any i32 window (far beyond what the decimator gives) runs without a panic.
+        let wild: [i32; MAX_WINDOW] = core::array::from_fn(|i| {
+            if i % 3 == 0 {
+                i32::MAX
+            } else {
+                i32::MIN + i as i32
+            }
+        });
+        q.analyze(&wild[..n], &mut g, &mut c);
+        assert!(c.len >= 1 && c.score[..c.len].iter().all(|v| v.is_finite()));
         let silent = [0i32; MAX_WINDOW];
         q.analyze(&silent[..n], &mut g, &mut c);
         assert_eq!(c.len, 1);
