@@ -11,6 +11,9 @@ fn main() {
     let memory: &[u8] = match target.as_str() {
         "thumbv7em-none-eabihf" => include_bytes!("mps2-an386.x"),
         "thumbv8m.main-none-eabihf" => include_bytes!("mps2-an505.x"),
+        // ARMv6-M code on the same board: its Cortex-M4 executes the ARMv6-M subset with the
+        // same instruction count (boards/qemu-m0).
+        "thumbv6m-none-eabi" => include_bytes!("mps2-an386.x"),
         other => panic!(
             "no QEMU board for target {other}: build with --target thumbv7em-none-eabihf \
              (mps2-an386, boards/qemu-m4) or --target thumbv8m.main-none-eabihf (mps2-an505, \

@@ -50,6 +50,9 @@ pub enum Command {
         /// Print one JSON object instead of tables.
         #[arg(long)]
         json: bool,
+        /// Also evaluate the fixed-point front-end (boards without an FPU) and compare.
+        #[arg(long)]
+        fixed: bool,
     },
     /// Time the front-end on generated speech-like audio (or a WAV file).
     BenchProsody {
@@ -251,7 +254,9 @@ fn parse_seconds(s: &str) -> Result<f64, String> {
 pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
     match &cli.command {
         Command::Prosody { wav, syllables } => prosody_cmd::run(wav, *syllables, out),
-        Command::EvalProsody { data, json } => eval_cmd::run(data.as_deref(), *json, out),
+        Command::EvalProsody { data, json, fixed } => {
+            eval_cmd::run(data.as_deref(), *json, *fixed, out)
+        }
         Command::BenchProsody { seconds, runs, wav } => {
             bench::run(*seconds, *runs, wav.as_deref(), out)
         }

@@ -7,6 +7,10 @@
 //! CSV. Pooled metrics use all matched frames of all files together. Syllables are counted for
 //! the files listed in `cmu-arctic/prompts.tsv`.
 //!
+//! With `--fixed` it evaluates the fixed-point front-end of boards without an FPU
+//! (`prosody::arith::Fixed`) too, and prints both reports and, per file, how far the fixed
+//! one's voicing agreement and gross pitch errors are from the `f32` one's.
+//!
 //! The data folder is optional (its licences keep it out of the repository): when the default
 //! folder is absent, this prints that nothing was measured and succeeds, so tests can skip; a
 //! folder given with `--data` that does not exist or holds no referenced WAV is an error (one
@@ -15,6 +19,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use gesture_runtime::prosody::arith::{Fixed, Float};
 use gesture_runtime::prosody::{ProsodyConfig, Step};
 use gesture_trainer::{audio, features};
 use serde_json::{json, Value};
@@ -108,10 +113,22 @@ fn wav_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<(), SimError> {
     Ok(())
 }
 
-fn analyse(path: &Path) -> Result<(Vec<eval::TrackFrame>, Vec<Step>), SimError> {
+/// Which front-end arithmetic to evaluate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arithmetic {
+    /// The `f32` front-end (the reference; what the simulator and the trainer run).
+    Float,
+    /// The fixed-point front-end of boards without an FPU.
+    Fixed,
+}
+
+fn analyse(path: &Path, arith: Arithmetic) -> Result<(Vec<eval::TrackFrame>, Vec<Step>), SimError> {
     let config = ProsodyConfig::DEFAULT;
     let pcm = audio::load_wav_at(path, config.sample_rate_hz)?;
-    let (frames, steps) = features::prosody_of(&pcm.samples, &config)?;
+    let (frames, steps) = match arith {
+        Arithmetic::Float => features::prosody_of_arith::<Float>(&pcm.samples, &config)?,
+        Arithmetic::Fixed => features::prosody_of_arith::<Fixed>(&pcm.samples, &config)?,
+    };
     // Through the CSV text, so values are rounded exactly as the script would read them.
     let mut csv = Vec::new();
     write_frames_csv(&mut csv, &frames)?;
@@ -129,6 +146,11 @@ fn relative(dir: &Path, p: &Path) -> String {
 
 /// Evaluates every WAV with a Praat reference under `dir`, and the prompts' syllable counts.
 pub fn evaluate(dir: &Path) -> Result<Report, SimError> {
+    evaluate_with(dir, Arithmetic::Float)
+}
+
+/// [`evaluate`] with the front-end arithmetic `arith`.
+pub fn evaluate_with(dir: &Path, arith: Arithmetic) -> Result<Report, SimError> {
     let mut wavs = Vec::new();
     wav_files(dir, &mut wavs)?;
     let ref_dir = dir.join("reference").join("praat");
@@ -148,7 +170,7 @@ pub fn evaluate(dir: &Path) -> Result<Report, SimError> {
                 path: ref_path.clone(),
                 source,
             })?;
-        let (ours, steps) = analyse(&wav)?;
+        let (ours, steps) = analyse(&wav, arith)?;
         let pairs = eval::match_frames(&ours, &reference);
         files.push(FileResult {
             file: relative(dir, &wav),
@@ -169,7 +191,7 @@ pub fn evaluate(dir: &Path) -> Result<Report, SimError> {
             let wav = dir.join("cmu-arctic").join(&p.file);
             let ours = match steps_of.iter().find(|(w, _)| *w == wav) {
                 Some((_, steps)) => eval::count_syllables(steps),
-                None => eval::count_syllables(&analyse(&wav)?.1),
+                None => eval::count_syllables(&analyse(&wav, arith)?.1),
             };
             syllables.push(SyllableResult {
                 file: relative(dir, &wav),
@@ -349,8 +371,66 @@ pub fn to_json(r: &Report) -> Value {
     })
 }
 
-/// Runs the subcommand: resolve the folder, evaluate, print.
-pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(), SimError> {
+/// Per file, the fixed-point front-end's voicing agreement and gross pitch error minus the
+/// `f32` one's: `(file, voicing delta, gpe delta)` (a worse fixed path has a negative voicing
+/// delta and a positive gpe delta).
+pub fn fixed_vs_float(float: &Report, fixed: &Report) -> Vec<(String, f64, f64)> {
+    float
+        .files
+        .iter()
+        .filter_map(|a| {
+            let b = fixed.files.iter().find(|b| b.file == a.file)?;
+            Some((
+                a.file.clone(),
+                b.metrics.voicing - a.metrics.voicing,
+                b.metrics.gpe - a.metrics.gpe,
+            ))
+        })
+        .collect()
+}
+
+/// The largest shortfalls of the fixed-point front-end against the `f32` one over `deltas`
+/// (from [`fixed_vs_float`]): `(voicing loss, its file, gpe increase, its file)`.
+pub fn worst_shortfall(deltas: &[(String, f64, f64)]) -> (f64, String, f64, String) {
+    let mut worst = (0.0f64, String::new(), 0.0f64, String::new());
+    for (file, dv, dg) in deltas {
+        if -dv > worst.0 {
+            worst.0 = -dv;
+            worst.1 = file.clone();
+        }
+        if *dg > worst.2 {
+            worst.2 = *dg;
+            worst.3 = file.clone();
+        }
+    }
+    worst
+}
+
+fn write_comparison(out: &mut impl Write, deltas: &[(String, f64, f64)]) -> std::io::Result<()> {
+    let w = deltas.iter().map(|d| d.0.len()).max().unwrap_or(4).max(22);
+    writeln!(out)?;
+    writeln!(out, "fixed-point minus f32, per file")?;
+    writeln!(out, "{:<w$} {:>9} {:>9}", "file", "voicing", "gpe")?;
+    for (file, dv, dg) in deltas {
+        writeln!(out, "{:<w$} {:>+9.4} {:>+9.4}", file, dv, dg)?;
+    }
+    let (lv, fv, lg, fg) = worst_shortfall(deltas);
+    writeln!(
+        out,
+        "largest shortfall: voicing {lv:.4} ({}), gpe {lg:.4} ({})",
+        if fv.is_empty() { "none" } else { &fv },
+        if fg.is_empty() { "none" } else { &fg }
+    )
+}
+
+/// Runs the subcommand: resolve the folder, evaluate, print. With `fixed`, both front-ends
+/// and their per-file differences.
+pub fn run(
+    data: Option<&Path>,
+    as_json: bool,
+    fixed: bool,
+    out: &mut impl Write,
+) -> Result<(), SimError> {
     let given = |reason: &str| -> SimError {
         SimError::Read {
             path: data.map(Path::to_path_buf).unwrap_or_default(),
@@ -390,10 +470,40 @@ pub fn run(data: Option<&Path>, as_json: bool, out: &mut impl Write) -> Result<(
         }
         return Ok(());
     }
-    if as_json {
-        writeln!(out, "{}", to_json(&report))?;
+    let fixed_report = if fixed {
+        Some(evaluate_with(&dir, Arithmetic::Fixed)?)
     } else {
+        None
+    };
+    if as_json {
+        let mut v = to_json(&report);
+        if let Some(f) = &fixed_report {
+            let deltas = fixed_vs_float(&report, f);
+            let (lv, fv, lg, fg) = worst_shortfall(&deltas);
+            v["fixed"] = to_json(f);
+            v["fixed_vs_f32"] = json!({
+                "files": deltas
+                    .iter()
+                    .map(|(file, dv, dg)| json!({"file": file, "voicing": dv, "gpe": dg}))
+                    .collect::<Vec<_>>(),
+                "voicing_loss": lv,
+                "voicing_loss_file": fv,
+                "gpe_increase": lg,
+                "gpe_increase_file": fg,
+            });
+        }
+        writeln!(out, "{v}")?;
+    } else {
+        if fixed_report.is_some() {
+            writeln!(out, "== f32 front-end ==")?;
+        }
         write_table(out, &report)?;
+        if let Some(f) = &fixed_report {
+            writeln!(out)?;
+            writeln!(out, "== fixed-point front-end (boards without an FPU) ==")?;
+            write_table(out, f)?;
+            write_comparison(out, &fixed_vs_float(&report, f))?;
+        }
     }
     Ok(())
 }

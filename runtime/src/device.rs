@@ -31,6 +31,7 @@ use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 #[cfg(doc)]
 use crate::controller::Controller;
 use crate::controller::{BlobController, ControllerError, ControllerEvent};
+use crate::prosody::arith::{Arith, DefaultArith};
 use crate::rig::{ChannelCal, RigError, ServoRig};
 
 /// Why a device could not be built from a blob (the controller's errors come from
@@ -97,24 +98,27 @@ impl SetDutyCycle for NullPin {
 }
 
 /// A blob's controller driving `N` servo pins (see the module docs).
-pub struct Device<'c, 'a, P, const N: usize> {
-    controller: &'c mut BlobController<'a>,
+pub struct Device<'c, 'a, P, const N: usize, A: Arith = DefaultArith> {
+    controller: &'c mut BlobController<'a, A>,
     rig: ServoRig<P, N>,
     dt_s: f32,
 }
 
-impl<'c, 'a, P: SetDutyCycle, const N: usize> Device<'c, 'a, P, N> {
+impl<'c, 'a, P: SetDutyCycle, const N: usize, A: Arith> Device<'c, 'a, P, N, A> {
     /// The device for the blob `controller` runs (build the controller in place with
     /// [`Controller::from_blob_in`]) on `pins`, with the blob's calibration and PWM period;
     /// drives the servos to neutral (power-up).
-    pub fn new(controller: &'c mut BlobController<'a>, pins: [P; N]) -> Result<Self, DeviceError> {
+    pub fn new(
+        controller: &'c mut BlobController<'a, A>,
+        pins: [P; N],
+    ) -> Result<Self, DeviceError> {
         Self::calibrated(controller, pins, None)
     }
 
     /// [`new`](Self::new) with the servo calibration of a rig file instead of the blob's:
     /// `cals` (one per blob channel, checked by the rig) and the PWM period.
     pub fn calibrated(
-        controller: &'c mut BlobController<'a>,
+        controller: &'c mut BlobController<'a, A>,
         pins: [P; N],
         calibration: Option<(&[ChannelCal], f32)>,
     ) -> Result<Self, DeviceError> {
@@ -198,12 +202,12 @@ impl<'c, 'a, P: SetDutyCycle, const N: usize> Device<'c, 'a, P, N> {
     }
 
     /// The controller (its belief, timing, ...).
-    pub fn controller(&self) -> &BlobController<'a> {
+    pub fn controller(&self) -> &BlobController<'a, A> {
         self.controller
     }
 
     /// The controller, to change its settings (e.g. [`Controller::set_timing`]).
-    pub fn controller_mut(&mut self) -> &mut BlobController<'a> {
+    pub fn controller_mut(&mut self) -> &mut BlobController<'a, A> {
         self.controller
     }
 

@@ -14,6 +14,9 @@
 //!   blob bytes give correct output or a typed error. Outputs are always finite.
 //! - Deterministic: `f32` arithmetic with `libm`, so the same input gives the same decisions on
 //!   the host and on a Cortex-M4F, and no result depends on how the input is chunked.
+//! - One runtime for chips with and without an FPU: the `fixed` feature makes the front-end's
+//!   per-sample and per-frame work integer ([`prosody::arith`]); the blob and every decision
+//!   after the front-end are the same code.
 //! - The trainer computes its features by calling this crate, so training and device features
 //!   cannot drift apart.
 //!

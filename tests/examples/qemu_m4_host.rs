@@ -7,10 +7,11 @@
 //!   amplified 16x into hard clipping, full-scale white noise from a fixed seed, and a
 //!   full-scale 200 Hz square wave from `i16::MIN` to `i16::MAX`).
 //!   Each also as a 16 kHz mono 16-bit WAV (`speech.wav`, `stress.wav`) for `gesture-sim run`.
-//! - `trace --blob BLOB --input NAME=FILE ...` prints the reference decision trace: the
-//!   firmware's own drive loop (`boards/qemu/src/drive.rs`, included below) over the same
+//! - `trace --blob BLOB --input NAME=FILE ... [--fixed]` prints the reference decision trace:
+//!   the firmware's own drive loop (`boards/qemu/src/drive.rs`, included below) over the same
 //!   samples in the same 256-sample chunks, so its output must equal the firmware's stdout
-//!   byte for byte.
+//!   byte for byte. `--fixed` runs the fixed-point front-end (`prosody::arith::Fixed`), as the
+//!   ARMv6-M firmware (`boards/qemu-m0`) does; without it, the `f32` one.
 //! - `sim-decisions --timeline timeline.json` prints the decisions of a `gesture-sim run`
 //!   (its `timeline.json`) as the trace's `decision` lines, for the same comparison against the
 //!   simulator itself.
@@ -24,11 +25,12 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use gesture_runtime::prosody::arith::Fixed;
 
 #[derive(Debug, Parser)]
 #[command(
     name = "qemu_m4_host",
-    about = "Inputs and reference trace for boards/qemu (qemu-m4, qemu-m33)"
+    about = "Inputs and reference traces for boards/qemu (qemu-m4, qemu-m33, qemu-m0)"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -63,6 +65,9 @@ enum Command {
         /// `NAME=FILE`: an input (raw i16 LE, 16 kHz), in the firmware's order.
         #[arg(long = "input", required = true)]
         inputs: Vec<String>,
+        /// Run the fixed-point front-end (the ARMv6-M firmware's) instead of the f32 one.
+        #[arg(long)]
+        fixed: bool,
     },
 }
 
@@ -157,7 +162,7 @@ fn sim_decisions(timeline: &Path) -> Result<(), String> {
     Ok(())
 }
 
-fn trace(blob: &Path, inputs: &[String]) -> Result<(), String> {
+fn trace(blob: &Path, inputs: &[String], fixed: bool) -> Result<(), String> {
     let blob_bytes = read(blob)?;
     for input in inputs {
         let (name, file) = input
@@ -165,7 +170,13 @@ fn trace(blob: &Path, inputs: &[String]) -> Result<(), String> {
             .ok_or_else(|| format!("--input {input}: expected NAME=FILE"))?;
         let audio = read(Path::new(file))?;
         let mut text = String::new();
-        let result = drive::run(name, &blob_bytes, &audio, &mut text, &mut drive::NoProbe);
+        let probe = &mut drive::NoProbe;
+        let result = if fixed {
+            drive::run_with::<Fixed>(name, &blob_bytes, &audio, &mut text, probe)
+        } else {
+            // The build's arithmetic: f32 (the host never turns on the runtime's `fixed`).
+            drive::run(name, &blob_bytes, &audio, &mut text, probe)
+        };
         print!("{text}");
         result.map_err(|e| {
             format!(
@@ -183,7 +194,11 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Audio { wav, seconds, out } => audio(wav, *seconds, out),
         Command::SimDecisions { timeline } => sim_decisions(timeline),
-        Command::Trace { blob, inputs } => trace(blob, inputs),
+        Command::Trace {
+            blob,
+            inputs,
+            fixed,
+        } => trace(blob, inputs, *fixed),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

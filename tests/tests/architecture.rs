@@ -23,6 +23,7 @@ const CRATES: &[&str] = &[
     "host-sim",
     "tests",
     "boards/blackpill-f411",
+    "boards/pico",
     "boards/pico2",
     "boards/qemu",
 ];

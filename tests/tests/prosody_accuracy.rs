@@ -63,3 +63,36 @@ fn cmu_arctic_syllable_total_within_15_percent() {
     assert_eq!(truth, 75);
     assert!(rel.abs() <= 0.15, "total syllable error {rel}");
 }
+
+#[test]
+fn fixed_point_front_end_meets_the_thresholds_and_tracks_the_f32_one() {
+    const TEST: &str = "fixed_point_front_end_meets_the_thresholds_and_tracks_the_f32_one";
+    let Some(dir) = data_dir(TEST) else {
+        return;
+    };
+    use host_sim::eval_cmd::{evaluate_with, fixed_vs_float, syllable_totals, Arithmetic};
+    let float = evaluate_with(&dir, Arithmetic::Float).expect("evaluation runs");
+    let fixed = evaluate_with(&dir, Arithmetic::Fixed).expect("evaluation runs");
+    assert_eq!(fixed.files.len(), float.files.len());
+    // The thresholds the f32 front-end meets on this data (pooled), met by the fixed one.
+    let p = &fixed.pooled;
+    eprintln!(
+        "fixed-point pooled: voicing {:.4} gpe {:.4} int_r {:.4} (f32: {:.4} {:.4} {:.4})",
+        p.voicing, p.gpe, p.int_r, float.pooled.voicing, float.pooled.gpe, float.pooled.int_r
+    );
+    assert!(p.voicing >= 0.95, "pooled voicing {}", p.voicing);
+    assert!(p.gpe <= 0.02, "pooled gross pitch error {}", p.gpe);
+    assert!(p.int_r >= 0.99, "pooled intensity r {}", p.int_r);
+    let (ours, truth, rel) = syllable_totals(&fixed.syllables);
+    eprintln!(
+        "fixed-point syllables: {ours} of {truth} ({:+.1}%)",
+        100.0 * rel
+    );
+    assert!(rel.abs() <= 0.05, "syllable total error {rel}");
+    // No file worse than the f32 front-end by more than 0.02 in voicing or gross pitch error.
+    for (file, dv, dg) in fixed_vs_float(&float, &fixed) {
+        eprintln!("{file}: voicing {dv:+.4} gpe {dg:+.4} (fixed minus f32)");
+        assert!(dv >= -0.02, "{file}: voicing {dv:+.4} against f32");
+        assert!(dg <= 0.02, "{file}: gross pitch error {dg:+.4} against f32");
+    }
+}

@@ -7,6 +7,7 @@
 //!
 //! Allocates the two output vectors; never panics.
 
+use gesture_runtime::prosody::arith::{Arith, DefaultArith};
 use gesture_runtime::prosody::{ConfigError, Event, Frame, FrontEnd, ProsodyConfig, Step};
 
 /// Runs the front-end over a whole stream (`samples` at `config.sample_rate_hz`): pushes
@@ -16,7 +17,16 @@ pub fn prosody_of(
     samples: &[i16],
     config: &ProsodyConfig,
 ) -> Result<(Vec<Frame>, Vec<Step>), ConfigError> {
-    let mut fe = FrontEnd::new(config)?;
+    prosody_of_arith::<DefaultArith>(samples, config)
+}
+
+/// [`prosody_of`] with the front-end arithmetic `A` (`f32` or the fixed-point front-end of
+/// boards without an FPU), for evaluations that compare the two; training uses the default.
+pub fn prosody_of_arith<A: Arith>(
+    samples: &[i16],
+    config: &ProsodyConfig,
+) -> Result<(Vec<Frame>, Vec<Step>), ConfigError> {
+    let mut fe = FrontEnd::<A>::with_arith(config)?;
     let mut frames = Vec::with_capacity(samples.len() / (config.sample_rate_hz as usize / 100) + 1);
     let mut steps = Vec::new();
     let mut sink = |ev: Event| match ev {

@@ -46,6 +46,7 @@ use gesture_runtime::blob::{Blob, BlobError};
 use gesture_runtime::controller::{BlobController, ControllerEvent};
 use gesture_runtime::device::{Device, DeviceError, DeviceEvent};
 use gesture_runtime::policy::Choice;
+use gesture_runtime::prosody::arith::{Arith, DefaultArith};
 use gesture_runtime::rig::{duty_cycle, PULSE_MAX_US, PULSE_MIN_US};
 
 /// Samples per DMA buffer (16 ms at 16 kHz).
@@ -58,8 +59,8 @@ pub const AUDIO_RATE_HZ: u32 = 16_000;
 /// Servo channels of the board (the puppet rig, `rigs/puppet-8ch.toml`).
 pub const CHANNELS: usize = 8;
 
-/// The device loop over a blob, as [`run`] builds it.
-pub type BoardDevice<'c, 'a> = Device<'c, 'a, RecordingPin, CHANNELS>;
+/// The device loop over a blob, as [`run`] builds it (`A`: the front-end's arithmetic).
+pub type BoardDevice<'c, 'a, A = DefaultArith> = Device<'c, 'a, RecordingPin, CHANNELS, A>;
 
 /// Why a run stopped.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -213,16 +214,29 @@ fn fnv(mut h: u32, values: &[f32]) -> u32 {
 /// Builds the controller over `blob` in `slot`, in place and out of line, so that neither a
 /// copy of it nor the temporaries of its construction stay on the stack while samples run.
 #[inline(never)]
-fn build<'s, 'a>(
-    slot: &'s mut Option<BlobController<'a>>,
+fn build<'s, 'a, A: Arith>(
+    slot: &'s mut Option<BlobController<'a, A>>,
     blob: &'a Blob<'a>,
-) -> Result<&'s mut BlobController<'a>, DeviceError> {
-    BlobController::from_blob_in(slot, blob).map_err(DeviceError::Controller)
+) -> Result<&'s mut BlobController<'a, A>, DeviceError> {
+    BlobController::from_blob_arith_in(slot, blob).map_err(DeviceError::Controller)
 }
 
 /// Runs a fresh controller from `blob` over `audio` (little-endian i16 at 16 kHz) in
-/// [`CHUNK`]-sample buffers, writing the trace for input `name` to `out`.
+/// [`CHUNK`]-sample buffers, writing the trace for input `name` to `out`. The front-end's
+/// arithmetic is the build's ([`run_with`] chooses it).
 pub fn run(
+    name: &str,
+    blob: &[u8],
+    audio: &[u8],
+    out: &mut impl Write,
+    probe: &mut impl Probe,
+) -> Result<Summary, RunError> {
+    run_with::<DefaultArith>(name, blob, audio, out, probe)
+}
+
+/// [`run`] with the front-end arithmetic `A` (the host reference runs the fixed-point
+/// front-end of an ARMv6-M firmware with it).
+pub fn run_with<A: Arith>(
     name: &str,
     blob: &[u8],
     audio: &[u8],
@@ -248,7 +262,7 @@ pub fn run(
     let duty_min = duty_cycle(PULSE_MIN_US, period_us, u16::MAX);
     let duty_max = duty_cycle(PULSE_MAX_US, period_us, u16::MAX);
 
-    let mut slot = None;
+    let mut slot: Option<BlobController<'_, A>> = None;
     let controller = build(&mut slot, &blob).map_err(RunError::Device)?;
     let tones = blob.tones();
     if tones > 0 {
@@ -259,7 +273,7 @@ pub fn run(
             .set_style(&w[..tones])
             .map_err(|_| RunError::Style)?;
     }
-    let mut device: BoardDevice<'_, '_> =
+    let mut device: BoardDevice<'_, '_, A> =
         Device::new(controller, [RecordingPin::default(); CHANNELS]).map_err(RunError::Device)?;
     probe.ready();
 

@@ -60,8 +60,8 @@
 //! written where they stay, so construction needs only a few KiB of stack beyond the controller
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
+mod build;
 mod event;
-mod from_blob;
 mod labels;
 
 use crate::blob::Blob;
@@ -80,6 +80,7 @@ pub use event::{ControllerError, ControllerEvent, LabelOutcome};
 use labels::Labels;
 pub use labels::{LabelError, LABEL_QUEUE};
 
+use crate::prosody::arith::{Arith, DefaultArith};
 use crate::prosody::{Event, FrontEnd, ProsodyConfig};
 
 /// A cut decided and waiting for the hands to pause.
@@ -94,17 +95,24 @@ struct Deferred {
 }
 
 /// A controller over a blob's tables: what every host tool and board runs (built by
-/// [`Controller::from_blob`] or [`Controller::from_blob_in`]).
-pub type BlobController<'a> = Controller<'a, Blob<'a>, Blob<'a>>;
+/// [`Controller::from_blob`] or [`Controller::from_blob_in`]; `A`: the front-end's
+/// arithmetic, the build's by default).
+pub type BlobController<'a, A = DefaultArith> = Controller<'a, Blob<'a>, Blob<'a>, A>;
 
-/// The whole on-device controller over validated tables `T` (policy) and `L` (library).
-pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
+/// The whole on-device controller over validated tables `T` (policy) and `L` (library), with
+/// the front-end arithmetic `A` (the build's by default; `prosody::arith`).
+pub struct Controller<
+    'a,
+    T: PolicyTables + ?Sized,
+    L: LibraryFrames + ?Sized,
+    A: Arith = DefaultArith,
+> {
     tables: &'a T,
     lib: &'a L,
     crf: CrfWeights<'a>,
     gmm: [GmmComponent; MAX_CLUSTERS],
     clusters: usize,
-    front_end: FrontEnd,
+    front_end: FrontEnd<A>,
     normalizer: StepNormalizer,
     belief: Belief,
     uniform: [f32; MAX_STATES],
@@ -147,26 +155,9 @@ pub struct Controller<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> {
     pause_ms: u32,
 }
 
-impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized> Controller<'a, T, L> {
-    /// A controller at the start of segment 0 with a uniform belief, over tables that need
-    /// not come from a blob (the runtime's tests build small ones by hand). Host tools and
-    /// boards use [`from_blob`](Self::from_blob).
-    pub fn new(
-        config: &ProsodyConfig,
-        gmm: &[GmmComponent],
-        crf: CrfWeights<'a>,
-        tables: &'a T,
-        lib: &'a L,
-    ) -> Result<Self, ControllerError> {
-        let mut slot = None;
-        Self::new_in(&mut slot, config, gmm, crf, tables, lib)?;
-        slot.ok_or(ControllerError::Dimensions)
-    }
-
-    /// The controller [`new`](Self::new) returns, built in place in `slot` (on the caller's
-    /// stack or in a `static`) without a temporary copy: the big parts are written where they
-    /// stay. On an error `slot` is `None`.
-    pub fn new_in<'s>(
+impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'a, T, L, A> {
+    /// [`new_in`](Controller::new_in) with the front-end arithmetic `A`.
+    pub fn new_arith_in<'s>(
         slot: &'s mut Option<Self>,
         config: &ProsodyConfig,
         gmm: &[GmmComponent],

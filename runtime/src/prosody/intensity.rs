@@ -75,7 +75,7 @@ pub struct Intensity {
 }
 
 /// Modified Bessel function of the first kind, order 0 (power series; converges for all x).
-fn bessel_i0(x: f64) -> f64 {
+pub(crate) fn bessel_i0(x: f64) -> f64 {
     let q = 0.25 * x * x;
     let mut term = 1.0f64;
     let mut sum = 1.0f64;

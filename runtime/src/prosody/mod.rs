@@ -16,7 +16,8 @@
 //! **Determinism.** Samples are processed one at a time into fixed rings; a frame is computed
 //! when its last sample arrives. The chunking of the input therefore cannot change any result:
 //! pushing 1, 7, 160 or 4096 samples at a time gives bit-identical frames and steps (tested).
-//! All arithmetic is `f32` with `libm`, so host and Cortex-M4F agree bit for bit.
+//! The arithmetic is `f32` with `libm`, or with the `fixed` feature integers up to each
+//! frame's candidates and intensity ([`arith`]); either way host and device agree bit for bit.
 //!
 //! **Safety.** No allocation, no recursion, no panics for any input; every output is finite
 //! (intensity of exact silence is Praat's `-300 dB`). The state has a compile-time size
@@ -25,10 +26,13 @@
 //! Sample rates: 8 to 16 kHz in whole kHz (the pitch path runs at half the rate above 8 kHz).
 //! Hosts resample other rates before feeding the front-end.
 
+pub mod arith;
 pub mod decimate;
 mod frame;
 pub mod intensity;
+pub mod intensity_fixed;
 pub mod pitch;
+pub mod pitch_fixed;
 pub mod syllable;
 pub mod viterbi;
 
@@ -37,9 +41,8 @@ pub use syllable::{Step, StepKind, SyllableParams};
 
 pub use frame::HOP_S;
 
-use decimate::HalfBand;
-use intensity::Intensity;
-use pitch::{Candidates, GlobalPeak, PitchAnalyzer, MAX_WINDOW};
+use arith::{AnalyzePitch, Arith, Decimate, DefaultArith, MeasureIntensity};
+use pitch::{Candidates, GlobalPeak, MAX_WINDOW};
 use syllable::SyllableDetector;
 use viterbi::PathFinder;
 
@@ -50,8 +53,7 @@ pub const MAX_RATE_HZ: u32 = 16_000;
 /// Default front-end rate (Hz).
 pub const DEFAULT_RATE_HZ: u32 = 16_000;
 
-/// Ring of decimated samples (power of two, holds a window plus slack).
-const PITCH_RING: usize = 512;
+use decimate::PITCH_RING;
 const _: () = assert!(PITCH_RING >= MAX_WINDOW + 64 && PITCH_RING.is_power_of_two());
 
 /// Front-end settings; stored in the policy blob so training and device use the same ones.
@@ -198,24 +200,25 @@ fn finite_nonneg(v: f32) -> bool {
     v.is_finite() && v >= 0.0
 }
 
-/// The streaming front-end. See the module docs for timing and invariants.
+/// The streaming front-end. See the module docs for timing and invariants. `A` is its
+/// arithmetic ([`arith`]): by default `f32`, integers with the `fixed` feature.
 #[derive(Clone, Debug)]
-pub struct FrontEnd {
+pub struct FrontEnd<A: Arith = DefaultArith> {
     config: ProsodyConfig,
     /// Input samples per frame hop.
     hop: u32,
     /// Decimated samples per frame hop.
     pitch_hop: u32,
-    decimator: Option<HalfBand>,
+    decimator: Option<A::Decimator>,
     /// Output delay of the decimator in decimated samples.
     delay: u64,
-    ring: [f32; PITCH_RING],
+    ring: [A::Sample; PITCH_RING],
     /// Decimated samples produced so far (including the decimator's delay).
     produced: u64,
-    analyzer: PitchAnalyzer,
+    analyzer: A::Analyzer,
     global: GlobalPeak,
     path: PathFinder,
-    intensity: Intensity,
+    intensity: A::Intensity,
     syllables: SyllableDetector,
     /// Next frame to analyse for pitch.
     next_pitch: u32,
@@ -228,8 +231,17 @@ pub struct FrontEnd {
 }
 
 impl FrontEnd {
-    /// A front-end for `config`, or why the config is refused.
+    /// A front-end for `config` with the build's arithmetic ([`DefaultArith`]), or why the
+    /// config is refused.
     pub fn new(config: &ProsodyConfig) -> Result<Self, ConfigError> {
+        Self::with_arith(config)
+    }
+}
+
+impl<A: Arith> FrontEnd<A> {
+    /// A front-end for `config` with the arithmetic `A` (host tools compare both paths with
+    /// `FrontEnd::<Float>::with_arith` and `FrontEnd::<Fixed>::with_arith`).
+    pub fn with_arith(config: &ProsodyConfig) -> Result<Self, ConfigError> {
         let mut me = Self::blank();
         me.configure(config)?;
         Ok(me)
@@ -246,12 +258,12 @@ impl FrontEnd {
             pitch_hop: 0,
             decimator: None,
             delay: 0,
-            ring: [0.0; PITCH_RING],
+            ring: [A::ZERO; PITCH_RING],
             produced: 0,
-            analyzer: PitchAnalyzer::blank(),
+            analyzer: A::Analyzer::blank(),
             global: GlobalPeak::new(),
             path: PathFinder::new(&ProsodyConfig::DEFAULT.pitch),
-            intensity: Intensity::blank(),
+            intensity: A::Intensity::blank(),
             syllables: SyllableDetector::new(ProsodyConfig::DEFAULT.syllables),
             next_pitch: 1,
             limit: u32::MAX,
@@ -279,12 +291,16 @@ impl FrontEnd {
         self.hop = rate / 100;
         self.pitch_hop = pitch_rate / 100;
         self.decimator = if decimate {
-            Some(HalfBand::new())
+            Some(A::Decimator::fresh())
         } else {
             None
         };
-        self.delay = if decimate { HalfBand::DELAY as u64 } else { 0 };
-        self.ring.fill(0.0);
+        self.delay = if decimate {
+            <A::Decimator as Decimate<A::Sample>>::DELAY as u64
+        } else {
+            0
+        };
+        self.ring.fill(A::ZERO);
         self.produced = 0;
         self.global = GlobalPeak::new();
         self.path = PathFinder::new(p);
@@ -303,8 +319,8 @@ impl FrontEnd {
 
     /// Forgets all input: the next sample starts a new stream at time 0.
     pub fn reset(&mut self) {
-        self.decimator = self.decimator.as_ref().map(|_| HalfBand::new());
-        self.ring = [0.0; PITCH_RING];
+        self.decimator = self.decimator.as_ref().map(|_| A::Decimator::fresh());
+        self.ring = [A::ZERO; PITCH_RING];
         self.produced = 0;
         self.global = GlobalPeak::new();
         self.path.reset();
@@ -355,29 +371,26 @@ impl FrontEnd {
 
     /// Decimates `run` into the pitch ring (no analysis).
     fn pitch_input(&mut self, run: &[i16]) {
-        let ring = &mut self.ring;
-        let mut produced = self.produced;
-        let mut store = |y: f32| {
-            ring[(produced % PITCH_RING as u64) as usize] = y;
-            produced += 1;
-        };
         match &mut self.decimator {
-            Some(d) => d.push_slice(run, &mut store),
-            None => run.iter().for_each(|&s| store(s as f32 * (1.0 / 32768.0))),
+            Some(d) => self.produced = d.push_into(run, &mut self.ring, self.produced),
+            None => {
+                for &s in run {
+                    self.ring[(self.produced % PITCH_RING as u64) as usize] = A::sample(s);
+                    self.produced += 1;
+                }
+            }
         }
-        self.produced = produced;
     }
 
     #[inline]
     fn push_one(&mut self, s: i16, sink: &mut impl FnMut(Event)) {
         self.intensity.push(s);
-        let x = s as f32 * (1.0 / 32768.0);
         let y = match &mut self.decimator {
-            Some(d) => match d.push(x) {
+            Some(d) => match d.push_sample(s) {
                 Some(y) => y,
                 None => return,
             },
-            None => x,
+            None => A::sample(s),
         };
         self.ring[(self.produced % PITCH_RING as u64) as usize] = y;
         self.produced += 1;
@@ -395,7 +408,7 @@ impl FrontEnd {
         // ring position (time index + delay).
         // Indices before the stream's start wrap to ring slots that still hold zeros.
         let first = (k * self.pitch_hop as u64 + self.delay) as i64 - half as i64;
-        let mut win = [0.0f32; MAX_WINDOW];
+        let mut win = [A::ZERO; MAX_WINDOW];
         // At most two contiguous pieces of the ring (len <= MAX_WINDOW < PITCH_RING).
         let start = first.rem_euclid(PITCH_RING as i64) as usize;
         let len = len.min(MAX_WINDOW);
@@ -469,6 +482,7 @@ impl FrontEnd {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use arith::{Fixed, Float};
 
     #[test]
     fn rejects_bad_configs() {
@@ -515,5 +529,66 @@ mod tests {
             }
         });
         assert_eq!(frames, 100);
+    }
+
+    fn frames<A: Arith>(x: &[i16]) -> [Option<Frame>; 200] {
+        let mut fe = FrontEnd::<A>::with_arith(&ProsodyConfig::DEFAULT).unwrap();
+        let mut out = [None; 200];
+        let mut sink = |e: Event| {
+            if let Event::Frame(f) = e {
+                if let Some(slot) = out.get_mut(f.index as usize) {
+                    *slot = Some(f);
+                }
+            }
+        };
+        fe.push(x, &mut sink);
+        fe.finish(&mut sink);
+        out
+    }
+
+    #[test]
+    fn fixed_front_end_tracks_the_f32_one_on_a_gliding_tone() {
+        // 1.5 s at 16 kHz: a tone gliding 110 -> 260 Hz at a planted level (-12 dBFS), then
+        // 0.3 s of a faint one (-60 dBFS).
+        let mut x = [0i16; 24_000];
+        let mut phase = 0.0f64;
+        for (i, v) in x.iter_mut().enumerate() {
+            let t = i as f64 / 16_000.0;
+            let (f, amp) = if t < 1.2 {
+                (110.0 + 125.0 * t, 0.25)
+            } else {
+                (200.0, 0.001)
+            };
+            phase += 2.0 * core::f64::consts::PI * f / 16_000.0;
+            *v = libm::round(32767.0 * amp * libm::sin(phase)) as i16;
+        }
+        let (a, b) = (frames::<Float>(&x), frames::<Fixed>(&x));
+        let mut voiced = 0;
+        for k in 10..145 {
+            let (Some(fa), Some(fb)) = (a[k], b[k]) else {
+                panic!("frame {k} missing");
+            };
+            let t = k as f64 * 0.01;
+            if (0.1..1.1).contains(&t) {
+                // The planted pitch, within 0.5 % on both paths, and the paths within 0.1 %.
+                let want = 110.0 + 125.0 * t;
+                let (pa, pb) = (fa.f0_hz.unwrap() as f64, fb.f0_hz.unwrap() as f64);
+                assert!(
+                    (pb - want).abs() < 0.005 * want,
+                    "frame {k}: {pb} vs {want}"
+                );
+                assert!((pa - pb).abs() < 0.001 * pa, "frame {k}: {pa} vs {pb}");
+                // Mean square amp^2 / 2 at full scale 1: 10 log10(0.25^2 / 2 / 4e-10).
+                let level = 10.0 * libm::log10(0.25 * 0.25 / 2.0 / 4.0e-10);
+                assert!((fb.intensity_db as f64 - level).abs() < 0.1, "frame {k}");
+                voiced += 1;
+            }
+            assert_eq!(fa.f0_hz.is_some(), fb.f0_hz.is_some(), "frame {k}");
+            assert!(
+                (fa.intensity_db - fb.intensity_db).abs() < 0.01,
+                "frame {k}"
+            );
+        }
+        assert_eq!(voiced, 100);
     }
 }

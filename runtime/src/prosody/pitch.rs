@@ -193,19 +193,13 @@ impl PitchAnalyzer {
     /// unusable) when the window does not fit the capacities.
     pub(crate) fn configure(&mut self, rate_hz: u32, params: PitchParams) -> Option<()> {
         let rate = rate_hz as f32;
-        let nominal = libm::floorf(3.0 * rate / params.floor_hz) as usize;
-        let half = (nominal / 2).checked_sub(1)?;
-        let window_len = 2 * half;
-        if !(8..=MAX_WINDOW).contains(&window_len) {
-            return None;
-        }
-        let period = libm::floorf(rate / params.floor_hz) as usize;
-        let half_period = period / 2 + 1;
-        let min_lag = (libm::ceilf(rate / params.ceiling_hz) as usize).max(2);
-        let max_lag = (window_len / 3 + 2).min(MAX_LAGS - 2);
-        if min_lag + 2 >= max_lag || period > half {
-            return None;
-        }
+        let Sizes {
+            window_len,
+            period,
+            half_period,
+            min_lag,
+            max_lag,
+        } = Sizes::new(rate_hz, &params)?;
         self.hann.fill(0.0);
         for (i, h) in self.hann.iter_mut().take(window_len).enumerate() {
             let phase = (i + 1) as f64 * 2.0 * core::f64::consts::PI / (window_len + 1) as f64;
@@ -277,27 +271,10 @@ impl PitchAnalyzer {
                 local_peak = a;
             }
         }
-        let global_peak = global.update(local_peak);
-        let ratio = if local_peak > global_peak {
-            1.0
-        } else {
-            local_peak / global_peak
-        };
         let p = &self.params;
-        // Praat's unvoiced strength: voicing threshold, plus a bonus that grows as the frame
-        // falls below the silence threshold.
-        let silence_bonus = 2.0 - ratio / self.silent_ratio;
-        out.score[0] = p.voicing_threshold
-            + if silence_bonus > 0.0 {
-                silence_bonus
-            } else {
-                0.0
-            };
-        // Below the silence ratio the unvoiced score exceeds 1.45 while a voiced score is at
-        // most ~1.03, and staying voiced through this frame saves at most two voiced/unvoiced
-        // transitions (2 x 0.14): the path finder can never choose a voiced candidate here, so
-        // skip the transforms. This is exact, not an approximation.
-        if local_peak == 0.0 || ratio < self.silent_ratio || !(local_peak.is_finite()) {
+        let silent;
+        (out.score[0], silent) = unvoiced_score(p, self.silent_ratio, local_peak, global);
+        if silent {
             return;
         }
         let mut r = [0.0f32; MAX_LAGS];
@@ -314,50 +291,154 @@ impl PitchAnalyzer {
         // Candidates ranked by Praat's "strength - octaveCost * log2(floor / f)".
         let mut rank = [0.0f32; MAX_CANDIDATES];
         let mut n = 1usize;
+        let log2_range = (libm::log2f(p.floor_hz), libm::log2f(p.ceiling_hz));
         for i in self.min_lag.max(2)..self.max_lag {
             let (r0, r1, r2) = (r[i - 1], r[i], r[i + 1]);
             if !(r1 > threshold && r1 > r0 && r1 >= r2) {
                 continue;
             }
-            let dr = 0.5 * (r2 - r0);
-            let d2r = 2.0 * r1 - r0 - r2;
-            let (lag, mut strength) = if d2r > 0.0 {
-                (i as f32 + dr / d2r, r1 + 0.5 * dr * dr / d2r)
-            } else {
-                (i as f32, r1)
-            };
-            if strength > 1.0 {
-                strength = 1.0 / strength;
-            }
-            let freq = self.rate / lag;
-            if !(freq >= p.floor_hz * 0.5 && freq <= p.ceiling_hz) {
-                continue;
-            }
-            let l2 = libm::log2f(freq);
-            let local_rank = strength + p.octave_cost * (l2 - libm::log2f(p.floor_hz));
-            let place = if n < MAX_CANDIDATES {
-                n += 1;
-                n - 1
-            } else {
-                let mut weakest = 1;
-                for k in 2..MAX_CANDIDATES {
-                    if rank[k] < rank[weakest] {
-                        weakest = k;
-                    }
-                }
-                if local_rank <= rank[weakest] {
-                    continue;
-                }
-                weakest
-            };
-            rank[place] = local_rank;
-            out.freq[place] = freq;
-            out.log2f[place] = l2;
-            // Path-finder score: strength minus octave cost relative to the ceiling.
-            out.score[place] = strength - p.octave_cost * (libm::log2f(p.ceiling_hz) - l2);
+            add_peak(
+                p,
+                self.rate,
+                log2_range,
+                i,
+                [r0, r1, r2],
+                &mut rank,
+                &mut n,
+                out,
+            );
         }
         out.len = n;
     }
+}
+
+/// The analysis sizes for a pitch rate, the same for both arithmetics.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Sizes {
+    /// Window length (even, at most [`MAX_WINDOW`]).
+    pub window_len: usize,
+    /// Samples either side of the centre for the local mean (one longest period).
+    pub period: usize,
+    /// Samples either side of the centre for the local peak.
+    pub half_period: usize,
+    /// Shortest lag searched.
+    pub min_lag: usize,
+    /// Lag past the longest searched.
+    pub max_lag: usize,
+}
+
+impl Sizes {
+    /// The sizes for `rate_hz`, or `None` when the window does not fit the capacities.
+    pub(crate) fn new(rate_hz: u32, params: &PitchParams) -> Option<Self> {
+        let rate = rate_hz as f32;
+        let nominal = libm::floorf(3.0 * rate / params.floor_hz) as usize;
+        let half = (nominal / 2).checked_sub(1)?;
+        let window_len = 2 * half;
+        if !(8..=MAX_WINDOW).contains(&window_len) {
+            return None;
+        }
+        let period = libm::floorf(rate / params.floor_hz) as usize;
+        let half_period = period / 2 + 1;
+        let min_lag = (libm::ceilf(rate / params.ceiling_hz) as usize).max(2);
+        let max_lag = (window_len / 3 + 2).min(MAX_LAGS - 2);
+        if min_lag + 2 >= max_lag || period > half {
+            return None;
+        }
+        Some(Self {
+            window_len,
+            period,
+            half_period,
+            min_lag,
+            max_lag,
+        })
+    }
+}
+
+/// Praat's unvoiced strength for a frame with this local peak (the voicing threshold, plus a
+/// bonus that grows as the frame falls below the silence threshold), updating the running
+/// global peak; and whether the frame is silent, i.e. no voiced candidate can win it.
+///
+/// Below the silence ratio the unvoiced score exceeds 1.45 while a voiced score is at most
+/// ~1.03, and staying voiced through this frame saves at most two voiced/unvoiced transitions
+/// (2 x 0.14): the path finder can never choose a voiced candidate there, so the analysis
+/// skips the autocorrelation. This is exact, not an approximation.
+#[inline(always)]
+pub(crate) fn unvoiced_score(
+    p: &PitchParams,
+    silent_ratio: f32,
+    local_peak: f32,
+    global: &mut GlobalPeak,
+) -> (f32, bool) {
+    let global_peak = global.update(local_peak);
+    let ratio = if local_peak > global_peak {
+        1.0
+    } else {
+        local_peak / global_peak
+    };
+    let silence_bonus = 2.0 - ratio / silent_ratio;
+    let score = p.voicing_threshold
+        + if silence_bonus > 0.0 {
+            silence_bonus
+        } else {
+            0.0
+        };
+    let silent = local_peak == 0.0 || ratio < silent_ratio || !(local_peak.is_finite());
+    (score, silent)
+}
+
+/// Adds the autocorrelation peak at lag `i` (normalized values `r` at lags `i - 1`, `i`,
+/// `i + 1`) to the candidates: parabolic refinement, Praat's reflection of strengths above 1,
+/// its octave-cost ranking (the weakest of a full set is replaced) and the path-finder score.
+/// `log2_range` is `(log2 floor, log2 ceiling)`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn add_peak(
+    p: &PitchParams,
+    rate: f32,
+    log2_range: (f32, f32),
+    i: usize,
+    r: [f32; 3],
+    rank: &mut [f32; MAX_CANDIDATES],
+    n: &mut usize,
+    out: &mut Candidates,
+) {
+    let [r0, r1, r2] = r;
+    let dr = 0.5 * (r2 - r0);
+    let d2r = 2.0 * r1 - r0 - r2;
+    let (lag, mut strength) = if d2r > 0.0 {
+        (i as f32 + dr / d2r, r1 + 0.5 * dr * dr / d2r)
+    } else {
+        (i as f32, r1)
+    };
+    if strength > 1.0 {
+        strength = 1.0 / strength;
+    }
+    let freq = rate / lag;
+    if !(freq >= p.floor_hz * 0.5 && freq <= p.ceiling_hz) {
+        return;
+    }
+    let l2 = libm::log2f(freq);
+    let local_rank = strength + p.octave_cost * (l2 - log2_range.0);
+    let place = if *n < MAX_CANDIDATES {
+        *n += 1;
+        *n - 1
+    } else {
+        let mut weakest = 1;
+        for k in 2..MAX_CANDIDATES {
+            if rank[k] < rank[weakest] {
+                weakest = k;
+            }
+        }
+        if local_rank <= rank[weakest] {
+            return;
+        }
+        weakest
+    };
+    rank[place] = local_rank;
+    out.freq[place] = freq;
+    out.log2f[place] = l2;
+    // Path-finder score: strength minus octave cost relative to the ceiling.
+    out.score[place] = strength - p.octave_cost * (log2_range.1 - l2);
 }
 
 /// Autocorrelation `r[l] = sum_i x[i] x[i+l]` of `buf` (zero-padded signal, destroyed) for lags
