@@ -8,6 +8,8 @@
 
 use core::cell::RefCell;
 
+use gesture_runtime::mic::{adc12_sample, DoubleBuffer};
+
 use critical_section::Mutex;
 use rp2040_hal::adc::{Adc, AdcChannel, AdcFifo};
 use rp2040_hal::pac::{self, interrupt};
@@ -19,50 +21,9 @@ pub const CHUNK: usize = 256;
 /// The ADC clock (the USB PLL, as `init_clocks_and_plls` sets it).
 const ADC_CLOCK_HZ: u32 = 48_000_000;
 
-/// The double buffer between the FIFO interrupt and the main loop.
-struct Buffers {
-    data: [[i16; CHUNK]; 2],
-    /// The half being filled.
-    filling: usize,
-    pos: usize,
-    /// A full half waiting for the main loop.
-    ready: Option<usize>,
-    overruns: u32,
-}
-
-impl Buffers {
-    const fn new() -> Self {
-        Self {
-            data: [[0; CHUNK]; 2],
-            filling: 0,
-            pos: 0,
-            ready: None,
-            overruns: 0,
-        }
-    }
-
-    fn push(&mut self, s: i16) {
-        self.data[self.filling][self.pos] = s;
-        self.pos += 1;
-        if self.pos == CHUNK {
-            if self.ready.is_some() {
-                // The main loop is late: the older buffer is dropped.
-                self.overruns = self.overruns.wrapping_add(1);
-            }
-            self.ready = Some(self.filling);
-            self.filling ^= 1;
-            self.pos = 0;
-        }
-    }
-
-    fn take(&mut self) -> Option<[i16; CHUNK]> {
-        self.ready.take().map(|half| self.data[half])
-    }
-}
-
 /// What the interrupt owns: the running FIFO (it borrows the `Adc` for ever).
 static FIFO: Mutex<RefCell<Option<AdcFifo<'static, u16>>>> = Mutex::new(RefCell::new(None));
-static BUFFERS: Mutex<RefCell<Buffers>> = Mutex::new(RefCell::new(Buffers::new()));
+static BUFFERS: Mutex<RefCell<DoubleBuffer<CHUNK>>> = Mutex::new(RefCell::new(DoubleBuffer::new()));
 
 /// The ADC FIFO interrupt: at least one sample is waiting; take all of them.
 #[interrupt]
@@ -75,10 +36,8 @@ fn ADC_IRQ_FIFO() {
         let mut buffers = BUFFERS.borrow_ref_mut(cs);
         while fifo.len() > 0 {
             // A conversion error (ERR bit) reads as the module's bias: silence, not a click.
-            let raw = fifo.read().unwrap_or(2048) as i32;
             // 12 bits around the module's half-supply bias, to full-scale i16.
-            let s = ((raw - 2048) << 4).clamp(i16::MIN as i32, i16::MAX as i32) as i16;
-            buffers.push(s);
+            buffers.push(adc12_sample(fifo.read().unwrap_or(2048)));
         }
     });
 }
@@ -103,6 +62,6 @@ pub fn start(adc: &'static mut Adc, pin: &mut impl AdcChannel) {
 pub fn take() -> (Option<[i16; CHUNK]>, u32) {
     critical_section::with(|cs| {
         let mut b = BUFFERS.borrow_ref_mut(cs);
-        (b.take(), b.overruns)
+        (b.take(), b.overruns())
     })
 }
