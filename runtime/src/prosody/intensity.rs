@@ -74,6 +74,29 @@ pub struct Intensity {
     scale: f32,
 }
 
+/// Praat's window for a pitch floor, in 1 ms blocks: the blocks either side of a frame's
+/// centre (its half length, 3.2 / floor s, rounded up) and the Kaiser weight (1 at the
+/// centre) of each, the block whose centre is `(i + 0.5)` ms from the frame's centre first.
+/// `None` when the half length is 0 or over [`MAX_HALF_BLOCKS`]. Both front-ends' intensity
+/// take their weights from here.
+pub(crate) fn block_weights(floor_hz: f32) -> Option<(usize, impl Iterator<Item = f64>)> {
+    let half_ms = 3.2e3 / floor_hz as f64;
+    let half_blocks = libm::ceil(half_ms) as usize;
+    if half_blocks > MAX_HALF_BLOCKS || half_blocks == 0 {
+        return None;
+    }
+    let beta = 2.0 * core::f64::consts::PI * core::f64::consts::PI + 0.5;
+    let peak = bessel_i0(beta);
+    Some((
+        half_blocks,
+        (0..half_blocks).map(move |i| {
+            let x = (i as f64 + 0.5) / half_ms;
+            let root = libm::sqrt((1.0 - x * x).max(0.0));
+            bessel_i0(beta * root) / peak
+        }),
+    ))
+}
+
 /// Modified Bessel function of the first kind, order 0 (power series; converges for all x).
 pub(crate) fn bessel_i0(x: f64) -> f64 {
     let q = 0.25 * x * x;
@@ -120,19 +143,10 @@ impl Intensity {
         if rate_hz % 1000 != 0 || rate_hz == 0 {
             return None;
         }
-        let half_ms = 3.2e3 / floor_hz as f64;
-        let half_blocks = libm::ceil(half_ms) as usize;
-        if half_blocks > MAX_HALF_BLOCKS || half_blocks == 0 {
-            return None;
-        }
+        let (half_blocks, weights) = block_weights(floor_hz)?;
         self.weights.fill(0.0);
-        let beta = 2.0 * core::f64::consts::PI * core::f64::consts::PI + 0.5;
-        let peak = bessel_i0(beta);
         let mut weight_sum = 0.0f64;
-        for (i, w) in self.weights.iter_mut().take(half_blocks).enumerate() {
-            let x = (i as f64 + 0.5) / half_ms;
-            let root = libm::sqrt((1.0 - x * x).max(0.0));
-            let v = bessel_i0(beta * root) / peak;
+        for (w, v) in self.weights.iter_mut().zip(weights) {
             *w = v as f32;
             weight_sum += 2.0 * v;
         }

@@ -21,7 +21,7 @@
 //!
 //! Invariants: fixed memory ([`MAX_BLOCKS`] blocks), no allocation, no panics, finite output.
 
-use super::intensity::{bessel_i0, MAX_BLOCKS, MAX_HALF_BLOCKS, SILENT_DB};
+use super::intensity::{block_weights, MAX_BLOCKS, MAX_HALF_BLOCKS, SILENT_DB};
 
 /// Highest rate (the front-end's): 16-sample blocks keep a block's square sum below 2^34.
 const MAX_RATE_HZ: u32 = 16_000;
@@ -98,19 +98,10 @@ impl IntensityQ {
         if rate_hz % 1000 != 0 || rate_hz == 0 || rate_hz > MAX_RATE_HZ {
             return None;
         }
-        let half_ms = 3.2e3 / floor_hz as f64;
-        let half_blocks = libm::ceil(half_ms) as usize;
-        if half_blocks > MAX_HALF_BLOCKS || half_blocks == 0 {
-            return None;
-        }
+        let (half_blocks, weights) = block_weights(floor_hz)?;
         self.weights.fill(0);
-        let beta = 2.0 * core::f64::consts::PI * core::f64::consts::PI + 0.5;
-        let peak = bessel_i0(beta);
         let mut sum = 0i64;
-        for (i, w) in self.weights.iter_mut().take(half_blocks).enumerate() {
-            let x = (i as f64 + 0.5) / half_ms;
-            let root = libm::sqrt((1.0 - x * x).max(0.0));
-            let v = bessel_i0(beta * root) / peak;
+        for (w, v) in self.weights.iter_mut().zip(weights) {
             // At least 1: a tail weight rounded to 0 would make a window whose only change
             // lies in its tails silent (-300 dB) where the f32 path and Praat see a level.
             *w = (libm::round(v * (1u32 << WEIGHT_BITS) as f64) as u32).max(1);
