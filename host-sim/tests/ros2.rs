@@ -89,6 +89,24 @@ fn stamp_ns(m: &Value) -> i64 {
     m["sec"].as_i64().unwrap() * 1_000_000_000 + m["nanosec"].as_i64().unwrap()
 }
 
+/// `gesture-sim run` of `blob` on `wav` with `--mcap`, which must succeed and write the URDF
+/// beside the run: (the temporary folder, kept while it is used; the run's folder; the MCAP file).
+fn mcap_run(blob: &Path, wav: &Path) -> (tempfile::TempDir, PathBuf, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("run");
+    let mcap = tmp.path().join("run.mcap");
+    let o = run_into(
+        blob,
+        wav,
+        &dir,
+        &["--no-video", "--mcap", mcap.to_str().unwrap()],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let stdout = text(&o.stdout);
+    assert!(stdout.contains("robot.urdf ("), "{stdout}");
+    (tmp, dir, mcap)
+}
+
 /// The MCAP file of a run: both decoders read one message per frame on /joint_states, names
 /// and positions those of motion.bvh (within 1e-6 rad), stamps and log times the frames'
 /// times on the audio clock; the URDF written beside it parses, its movable joints are the
@@ -99,18 +117,7 @@ fn mcap_and_urdf_of_a_run_open_in_ros_tools() {
         return;
     };
     let s = setup();
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("run");
-    let mcap = tmp.path().join("run.mcap");
-    let o = run_into(
-        &s.full,
-        &s.wav,
-        &dir,
-        &["--no-video", "--mcap", mcap.to_str().unwrap()],
-    );
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let stdout = text(&o.stdout);
-    assert!(stdout.contains("robot.urdf ("), "{stdout}");
+    let (tmp, dir, mcap) = mcap_run(&s.full, &s.wav);
     let (names, frames, fps) = bvh_states(&dir);
     assert!(frames.len() > 100);
 
@@ -511,21 +518,7 @@ fn body_puppet_run_urdf_shows_motion_bvh() {
         return;
     };
     let s = setup();
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("run");
-    let mcap = tmp.path().join("run.mcap");
-    let o = run_into(
-        &s.puppet,
-        &s.wav,
-        &dir,
-        &["--no-video", "--mcap", mcap.to_str().unwrap()],
-    );
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(
-        text(&o.stdout).contains("robot.urdf ("),
-        "{}",
-        text(&o.stdout)
-    );
+    let (tmp, dir, mcap) = mcap_run(&s.puppet, &s.wav);
     let bytes = std::fs::read(&s.puppet).unwrap();
     let blob = Blob::parse(&bytes).unwrap();
     let measures = body_measures(&blob);

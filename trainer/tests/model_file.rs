@@ -2,40 +2,13 @@
 //! exactly that into the blob; dimensions that do not fit (including products that would wrap)
 //! and impossible front-end settings are refused with the file's name, never a panic.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use gesture_runtime::blob::Blob;
-use gesture_trainer::corpus::{load_corpus, LoadOptions};
 use gesture_trainer::inference::model::InferenceModel;
-use gesture_trainer::inference::train::{fit, sequences, FitConfig};
 use gesture_trainer::pack::{pack_model, PackOptions};
-use gesture_trainer::synth::{write_corpus, SynthParams};
-
-fn corpus(dir: &Path) -> PathBuf {
-    let c = dir.join("corpus");
-    std::fs::create_dir_all(&c).unwrap();
-    let p = SynthParams {
-        minutes: 0.5,
-        seed: 5,
-        take_seconds: 30.0,
-    };
-    write_corpus(&p, &c, |_, _| {}).unwrap();
-    c
-}
-
-fn model(corpus: &Path) -> InferenceModel {
-    let c = load_corpus(&[corpus.to_path_buf()], &LoadOptions::default()).unwrap();
-    let (seqs, segs) = sequences(&c, None);
-    let cfg = FitConfig {
-        states: Some(2),
-        clusters: Some(2),
-        window: 2,
-        restarts: 2,
-        l2: Some(0.01),
-        ..FitConfig::default()
-    };
-    fit(&seqs, &segs, &cfg, &|_| {}).unwrap().0
-}
 
 fn edit(path: &Path, f: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
     let mut v: serde_json::Value =
@@ -49,8 +22,8 @@ fn edit(path: &Path, f: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
 #[test]
 fn the_front_end_goes_from_model_file_to_blob_and_bad_files_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let c = corpus(dir.path());
-    let m = model(&c);
+    let c = common::small_corpus(dir.path(), 5);
+    let m = common::small_model(&c);
     let path = dir.path().join("model.json");
     m.save(&path).unwrap();
     let back = InferenceModel::load(&path).unwrap();

@@ -2,40 +2,10 @@
 //! needed, a budget too small for one successor per exit is refused, and `--max-successors`
 //! still bounds the lists when a budget is given too.
 
-use std::path::{Path, PathBuf};
+mod common;
 
 use gesture_runtime::blob::Blob;
-use gesture_trainer::corpus::{load_corpus, LoadOptions};
-use gesture_trainer::inference::model::InferenceModel;
-use gesture_trainer::inference::train::{fit, sequences, FitConfig};
 use gesture_trainer::pack::{pack_model, PackOptions, Packed};
-use gesture_trainer::synth::{write_corpus, SynthParams};
-
-fn corpus(dir: &Path) -> PathBuf {
-    let c = dir.join("corpus");
-    std::fs::create_dir_all(&c).unwrap();
-    let p = SynthParams {
-        minutes: 0.5,
-        seed: 11,
-        take_seconds: 30.0,
-    };
-    write_corpus(&p, &c, |_, _| {}).unwrap();
-    c
-}
-
-fn model(corpus: &Path) -> InferenceModel {
-    let c = load_corpus(&[corpus.to_path_buf()], &LoadOptions::default()).unwrap();
-    let (seqs, segs) = sequences(&c, None);
-    let cfg = FitConfig {
-        states: Some(2),
-        clusters: Some(2),
-        window: 2,
-        restarts: 2,
-        l2: Some(0.01),
-        ..FitConfig::default()
-    };
-    fit(&seqs, &segs, &cfg, &|_| {}).unwrap().0
-}
 
 /// The longest successor list of the blob.
 fn longest_list(p: &Packed) -> usize {
@@ -49,8 +19,8 @@ fn longest_list(p: &Packed) -> usize {
 #[test]
 fn a_budget_cuts_the_successor_lists_and_max_successors_still_bounds_them() {
     let dir = tempfile::tempdir().unwrap();
-    let c = corpus(dir.path());
-    let m = model(&c);
+    let c = common::small_corpus(dir.path(), 11);
+    let m = common::small_model(&c);
     let lib = std::slice::from_ref(&c);
     let pack = |budget: Option<usize>, max: Option<usize>| {
         let mut opts = PackOptions {
