@@ -1,6 +1,7 @@
 //! What a controller reports while it runs (its events, and what became of each semantic
 //! label), and why one could not be built.
 
+use crate::player::PlayerCommand;
 use crate::policy::Decision;
 use crate::prosody::{ConfigError, Frame, Step};
 
@@ -33,6 +34,15 @@ pub enum ControllerEvent<'a> {
         segment: usize,
         /// Frame of that segment played.
         frame: usize,
+    },
+    /// What the controller asked of its player before the pose of `tick` (a cut, a run-on, a
+    /// turn, a change of playback rate, a hold): with the blob's library, these alone replay
+    /// the poses (a show file).
+    Play {
+        /// The tick whose pose the command precedes.
+        tick: u64,
+        /// The command.
+        command: PlayerCommand,
     },
     /// A syllable onset was detected (its start frame, 10 ms frames as in [`Frame`]).
     Onset(u32),

@@ -69,7 +69,7 @@ use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
 use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
-use crate::player::{LibraryFrames, Player, MAX_CHANNELS};
+use crate::player::{LibraryFrames, Player, PlayerCommand, MAX_CHANNELS};
 use crate::policy::{
     select_labelled, select_styled, Choice, History, Penalties, PolicyTables, Style, StyleError,
     Variety, Visit,
@@ -443,11 +443,25 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             && self.lib.is_beat(segment, self.player.frame());
         let hold = at_beat && !fresh && !self.ticks_reach_ms(self.holding + 1, t.beat_hold_ms);
         self.holding = if hold { self.holding + 1 } else { 0 };
+        let rate = self.player.rate();
         self.player.set_rate(if self.voice.resting() {
             crate::follow::rest_rate(self.tables.energy(segment))
         } else {
             1.0
         });
+        if self.player.rate() != rate {
+            let command = PlayerCommand::Rate(self.player.rate());
+            sink(ControllerEvent::Play {
+                tick: self.ticks,
+                command,
+            });
+        }
+        if hold {
+            sink(ControllerEvent::Play {
+                tick: self.ticks,
+                command: PlayerCommand::Hold,
+            });
+        }
         let played = self.player.tick_advancing(self.lib, &mut self.pose, !hold);
         // What leaves the controller is within the rig's limits and finite, whatever the
         // frames and the blend made of it (a board without the rig's own clamp must not drive
@@ -485,6 +499,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             // A rest holds until the speech returns, played to and fro (see crate::follow).
             if !self.player.backward() && self.player.at_end(self.lib) {
                 self.player.turn();
+                self.play(PlayerCommand::Turn, sink);
             }
             return;
         }
@@ -496,7 +511,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             };
             if pause {
                 self.deferred = None;
-                self.cut(d.segment, d.frame, tick);
+                self.cut(d.segment, d.frame, tick, sink);
             }
             return;
         }
@@ -568,6 +583,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             if t.max_wait_ms > 0 && self.lib.continues(segment) {
                 // Wait for an onset, the body moving on into the recorded successor.
                 self.player.run_on(self.lib);
+                self.play(PlayerCommand::RunOn, sink);
                 self.waiting = Some(e);
                 self.waited = 1;
                 return;
@@ -603,9 +619,22 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         beat.or((last + 1 >= len && last > f).then_some(last))
     }
 
+    /// Reports a player command given after the pose of the last tick (it precedes the next).
+    fn play(&self, command: PlayerCommand, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        sink(ControllerEvent::Play {
+            tick: self.ticks,
+            command,
+        });
+    }
+
     /// Cuts to segment `c` at frame `f` now.
-    fn cut(&mut self, c: usize, f: usize, tick: u64) {
+    fn cut(&mut self, c: usize, f: usize, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
         self.player.enter_at(self.lib, c, f);
+        let command = PlayerCommand::Enter {
+            segment: self.player.segment().min(u16::MAX as usize) as u16,
+            frame: self.player.frame().min(u16::MAX as usize) as u16,
+        };
+        self.play(command, sink);
         self.record_entry(c, tick.min(u32::MAX as u64) as u32);
     }
 
@@ -748,7 +777,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
                 } else if seamless {
                     self.record_entry(c, now);
                 } else {
-                    self.cut(c, decision.entry_frame, tick);
+                    self.cut(c, decision.entry_frame, tick, sink);
                 }
             }
         }

@@ -74,6 +74,46 @@ pub const MIN_RATE: f32 = 0.5;
 /// A phase this close to a whole frame counts as one (so a rate of 1 never interpolates).
 const RATE_EPSILON: f32 = 1.0e-4;
 
+/// What a controller asks of its player between two ticks, besides playing the next frame:
+/// everything a show file records so that a bare player, given the same library, shows the
+/// same poses ([`crate::controller::ControllerEvent::Play`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PlayerCommand {
+    /// [`Player::enter_at`]: cut to `segment` at `frame`.
+    Enter {
+        /// The segment entered.
+        segment: u16,
+        /// Its first frame shown.
+        frame: u16,
+    },
+    /// [`Player::run_on`]: into the recorded successor without a cut.
+    RunOn,
+    /// [`Player::turn`]: play the other way.
+    Turn,
+    /// [`Player::set_rate`]: frames per tick from this tick on.
+    Rate(f32),
+    /// This tick shows the same frame again ([`Player::tick_advancing`] with `advance` false).
+    Hold,
+}
+
+impl Player {
+    /// Carries out `command` (a show's playback; [`PlayerCommand::Hold`] is the tick's own
+    /// business and does nothing here).
+    pub fn apply<L: LibraryFrames + ?Sized>(&mut self, lib: &L, command: PlayerCommand) {
+        match command {
+            PlayerCommand::Enter { segment, frame } => {
+                if (segment as usize) < lib.segment_count() {
+                    self.enter_at(lib, segment as usize, frame as usize);
+                }
+            }
+            PlayerCommand::RunOn => self.run_on(lib),
+            PlayerCommand::Turn => self.turn(),
+            PlayerCommand::Rate(r) => self.set_rate(r),
+            PlayerCommand::Hold => {}
+        }
+    }
+}
+
 /// Segment playback with inertialized cuts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Player {
