@@ -325,7 +325,9 @@ pub fn live_loop_with(
                         writeln!(out, "{line}")
                     }
                 }
-                ControllerEvent::Frame(_) | ControllerEvent::Onset(_) => Ok(()),
+                ControllerEvent::Frame(_)
+                | ControllerEvent::Onset(_)
+                | ControllerEvent::Play { .. } => Ok(()),
             };
             if let (Err(e), None) = (r, &io_err) {
                 io_err = Some(e);

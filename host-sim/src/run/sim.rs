@@ -17,6 +17,7 @@ use std::time::{Duration, Instant};
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::{BlobController, ControllerEvent, LabelOutcome};
 use gesture_runtime::device::{Device, DeviceEvent};
+use gesture_runtime::player::PlayerCommand;
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::StepKind;
 use gesture_runtime::rig::{ChannelCal, MAX_CHANNELS};
@@ -109,6 +110,9 @@ pub struct Simulation {
     pub poses: Vec<Vec<f32>>,
     /// Per tick, the library segment and frame shown.
     pub shown: Vec<(usize, usize)>,
+    /// What the controller asked of its player, with the tick each command precedes (what a
+    /// show file records).
+    pub plays: Vec<(u64, PlayerCommand)>,
     /// One row of duty cycles per tick, from the virtual servo rig.
     pub duties: Vec<Vec<u16>>,
     /// One row per tick of the angles (deg) the servo rig commanded: the pose within the
@@ -398,6 +402,7 @@ fn record(
             sim.shown.push((segment, frame));
         }
         ControllerEvent::Onset(_) => {}
+        ControllerEvent::Play { tick, command } => sim.plays.push((tick, command)),
         ControllerEvent::Label {
             tick,
             label,
