@@ -235,7 +235,7 @@ fn run_on(
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
         }
         ControllerEvent::Onset(frame) => out.push(Rec::Onset(next_tick, frame)),
-        ControllerEvent::Label { .. } => {}
+        ControllerEvent::Label { .. } | ControllerEvent::Play { .. } => {}
         ControllerEvent::Frame(_) => {}
     };
     for ch in audio.chunks(chunk.max(1)) {
@@ -388,7 +388,10 @@ fn new_in_builds_in_place_what_new_builds() {
         ControllerEvent::Step { step, belief } => {
             out.push(Rec::Step(step.end_frame, belief.to_vec()))
         }
-        ControllerEvent::Onset(_) | ControllerEvent::Frame(_) | ControllerEvent::Label { .. } => {}
+        ControllerEvent::Onset(_)
+        | ControllerEvent::Frame(_)
+        | ControllerEvent::Label { .. }
+        | ControllerEvent::Play { .. } => {}
     };
     for ch in audio.chunks(333) {
         c.push(ch, &mut sink);
