@@ -322,7 +322,9 @@ pub fn run_with<A: Arith>(
             probe.event_begin(&ev);
             match ev {
                 ControllerEvent::Frame(_) => sum.frames += 1,
-                ControllerEvent::Onset(_) | ControllerEvent::Label { .. } => {}
+                ControllerEvent::Onset(_)
+                | ControllerEvent::Label { .. }
+                | ControllerEvent::Play { .. } => {}
                 ControllerEvent::Step { belief, .. } => {
                     sum.steps += 1;
                     sum.belief_hash = fnv(sum.belief_hash, belief);
