@@ -313,6 +313,14 @@ fn every_error_variant_is_reachable() {
         },
     );
     check(
+        &mutated(&|t| t.peaks = vec![]),
+        BlobError::TableLength {
+            field: Field::Peaks,
+            expected: 1,
+            found: 0,
+        },
+    );
+    check(
         &mutated(&|t| t.energy = vec![0]),
         BlobError::TableLength {
             field: Field::Energy,

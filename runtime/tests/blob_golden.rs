@@ -151,6 +151,8 @@ fn golden_bytes_and_round_trip() {
     assert_eq!(beats, [1, 4]);
     let calm: Vec<usize> = (0..8).filter(|&f| blob.is_calm_frame(f)).collect();
     assert_eq!(calm, [0, 5]);
+    let peaks: Vec<usize> = (0..8).filter(|&f| blob.is_peak_frame(f)).collect();
+    assert_eq!(peaks, [2]);
     assert_eq!(
         (blob.segment_energy(0), blob.segment_energy(1)),
         (-1.0, 1.5)

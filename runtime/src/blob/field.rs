@@ -126,6 +126,8 @@ pub enum Field {
     Calm,
     /// `library.energy`.
     Energy,
+    /// `library.peaks`.
+    Peaks,
     /// `library.groups`.
     Groups,
     /// `rig.calibration`.
@@ -209,6 +211,7 @@ impl Field {
             Self::Beats => "library.beats",
             Self::Calm => "library.calm",
             Self::Energy => "library.energy",
+            Self::Peaks => "library.peaks",
             Self::Groups => "library.groups",
             Self::Calibration => "rig.calibration",
             Self::Joints => "skeleton.joints",

@@ -5,7 +5,7 @@
 /// The first four bytes of every blob.
 pub const MAGIC: [u8; 4] = *b"GSTB";
 /// The format version this runtime reads and writes.
-pub const FORMAT_VERSION: u16 = 7;
+pub const FORMAT_VERSION: u16 = 8;
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 16;
 

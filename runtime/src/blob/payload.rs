@@ -370,6 +370,11 @@ pub struct LibrarySection<'a> {
     /// ([`crate::follow`]).
     #[serde(borrow)]
     pub energy: &'a [u8],
+    /// Strokes: a bit per frame of the frame table (as `beats`), set on the frames where the
+    /// hands' smoothed speed has a prominent peak (a gesture's stroke; the look-ahead lands
+    /// them on syllables).
+    #[serde(borrow)]
+    pub peaks: &'a [u8],
     /// Rotation groups: records `{first: u16, order: u8}`, three channels
     /// `first..first + 3` holding one joint rotation as Euler angles in that order
     /// ([`EULER_ORDERS`](super::EULER_ORDERS) index), blended as rotations; sorted, disjoint.

@@ -117,6 +117,10 @@ impl LibraryFrames for Blob<'_> {
         self.table_frame(c, f)
             .is_some_and(|t| self.is_calm_frame(t))
     }
+    fn is_peak(&self, c: usize, f: usize) -> bool {
+        self.table_frame(c, f)
+            .is_some_and(|t| self.is_peak_frame(t))
+    }
     fn calm_beat(&self, c: usize, f: usize) -> (bool, bool) {
         self.table_frame(c, f).map_or((false, false), |t| {
             (self.is_calm_frame(t), self.is_beat_frame(t))

@@ -292,6 +292,7 @@ fn library(l: &LibrarySection<'_>) -> Result<(), BlobError> {
     length(Field::Beats, l.beats, frames.div_ceil(8), 1)?;
     length(Field::Calm, l.calm, frames.div_ceil(8), 1)?;
     length(Field::Energy, l.energy, segs, 1)?;
+    length(Field::Peaks, l.peaks, frames.div_ceil(8), 1)?;
     if l.groups.len() % GROUP_RECORD_BYTES != 0 {
         return Err(BlobError::TableLength {
             field: Field::Groups,

@@ -462,6 +462,11 @@ impl<'a> Blob<'a> {
         frame_bit(self.payload.library.beats, f)
     }
 
+    /// Whether frame `f` of the frame table is a stroke (`library.peaks`; false out of range).
+    pub fn is_peak_frame(&self, f: usize) -> bool {
+        frame_bit(self.payload.library.peaks, f)
+    }
+
     /// Whether frame `f` of the frame table is calm (false out of range).
     pub fn is_calm_frame(&self, f: usize) -> bool {
         frame_bit(self.payload.library.calm, f)

@@ -74,6 +74,10 @@ pub trait LibraryFrames {
     fn is_beat(&self, _c: usize, _f: usize) -> bool {
         false
     }
+    /// Whether frame `f` of segment `c` is a stroke (a prominent peak of the hands' speed).
+    fn is_peak(&self, _c: usize, _f: usize) -> bool {
+        false
+    }
     /// Whether frame `f` of segment `c` is calm (the hands slow).
     fn is_calm(&self, _c: usize, _f: usize) -> bool {
         false

@@ -68,6 +68,7 @@ pub struct Tiny {
     pub beats: Vec<u8>,
     pub calm: Vec<u8>,
     pub energy: Vec<u8>,
+    pub peaks: Vec<u8>,
     pub groups: Vec<u8>,
     pub rig_name: String,
     pub period_us: f32,
@@ -290,6 +291,7 @@ impl Tiny {
             beats: vec![0b0001_0010],
             calm: vec![0b0010_0001],
             energy: vec![(-16i8) as u8, 24],
+            peaks: vec![0b0000_0100],
             groups: vec![],
             rig_name: "tiny".into(),
             period_us: 20_000.0,
@@ -347,6 +349,7 @@ impl Tiny {
                 beats: &self.beats,
                 calm: &self.calm,
                 energy: &self.energy,
+                peaks: &self.peaks,
                 groups: &self.groups,
             },
             rig: RigSection {
@@ -392,15 +395,16 @@ pub fn hex(b: &[u8]) -> String {
     b.iter().map(|x| format!("{x:02x}")).collect()
 }
 
-/// The tiny blob's bytes (format version 7: `styles` and `labels` absent, the final `00 00`;
+/// The tiny blob's bytes (format version 8: `styles` and `labels` absent, the final `00 00`;
 /// the `control` section after `policy.succ_cost_scale` is
 /// `01 32 ac02 0000c03f 8827 00008040 b0ea01 fa01 9601 c801 ee05 00002040 0000c03f`; the
 /// library ends with `continues` `02 01 00`, `beats` `01 12` (frames 1 and 4), `calm` `01 21`
-/// (frames 0 and 5), `energy` `02 f0 18` (-1 and 1.5 in sixteenths) and no `groups`,
+/// (frames 0 and 5), `energy` `02 f0 18` (-1 and 1.5 in sixteenths), `peaks` `01 04` (frame 2)
+/// and no `groups`,
 /// `00`). Changing the format changes
 /// these: bump FORMAT_VERSION and update docs/blob-format.md with them.
 pub const GOLDEN: &str = concat!(
-    "4753544207000000dd0100009b3f0961807d00009642000016448fc2f53c6666",
+    "4753544208000000df01000023727cea807d00009642000016448fc2f53c6666",
     "e63e0ad7233c3333b33e295c0f3e000000400000c8410000c84100008c420619",
     "02010134000000bf000080bf0000803e0000c0bf000000400000003f00008040",
     "0000a0bf0000003e0000003f000080be000000410000c03f0ad7233c0464009c",
@@ -410,12 +414,12 @@ pub const GOLDEN: &str = concat!(
     "00fbff0000070001000000cdcccc3d0132ac020000c03f882700008040b0ea01",
     "fa019601c801ee05000020400000c03f010000f0410602080000000003000000",
     "0403000300080ad7233c000020410c00006400c8002c019cff38ff04ffff0100",
-    "0200020201000112012102f018000474696e7900409c461c000000000000b4c2",
-    "0000b4420000803f0080bb440000204100007a43046865616401020968697073",
-    "0a6865616404ffff000018000000000000000000000000000000000000204100",
-    "0000000206030900010205030405030424000000000000b44200000000000000",
-    "0000000000000000000000000000000000000000000e0100000000000000a040",
-    "00000000060100010001010000",
+    "0200020201000112012102f0180104000474696e7900409c461c000000000000",
+    "b4c20000b4420000803f0080bb440000204100007a4304686561640102096869",
+    "70730a6865616404ffff00001800000000000000000000000000000000000020",
+    "41000000000206030900010205030405030424000000000000b4420000000000",
+    "00000000000000000000000000000000000000000000000e0100000000000000",
+    "a04000000000060100010001010000",
 );
 
 pub fn postcard_len<T: serde::Serialize>(v: &T) -> usize {

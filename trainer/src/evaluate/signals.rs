@@ -186,7 +186,11 @@ pub fn chance_shifts() -> impl Iterator<Item = f64> {
 /// [`STROKE_GAP_S`] of a higher stroke (SciPy's `find_peaks` with `prominence`, `wlen` and
 /// `distance`, written out: no crate here does it for `f64` slices).
 pub fn stroke_frames(hands: &[Vec<Vec3>], fps: f64) -> Vec<usize> {
-    let sp = smoothed_hand_speed(hands, fps);
+    speed_peaks(&smoothed_hand_speed(hands, fps), fps)
+}
+
+/// [`stroke_frames`] of a smoothed hand speed `sp` (per frame, at `fps`).
+pub fn speed_peaks(sp: &[f64], fps: f64) -> Vec<usize> {
     let n = sp.len();
     let min_prom = STROKE_PROMINENCE * quantile(&sp, 0.5);
     let reach = (STROKE_WINDOW_S * fps).round().max(1.0) as usize;

@@ -14,7 +14,7 @@ use gesture_runtime::blob::{ControlSection, FrontEndSection, Payload, EULER_ORDE
 use gesture_runtime::prosody::ProsodyConfig;
 use gesture_runtime::rig::ChannelCal;
 
-use crate::evaluate::signals::{quantile, smoothed_hand_speed, speed_minima};
+use crate::evaluate::signals::{quantile, smoothed_hand_speed, speed_minima, speed_peaks};
 use crate::inference::model::InferenceModel;
 use crate::inference::quantize::inference_section;
 use crate::motion::Skeleton;
@@ -122,6 +122,7 @@ impl Sections {
         let mut frames: Vec<Vec<f32>> = Vec::new();
         let mut offsets = Vec::with_capacity(lib.takes.len());
         let mut beats = Vec::new();
+        let mut peaks = Vec::new();
         // Per take, its first frame in the table and its hands' smoothed speed per frame.
         let mut speeds: Vec<(usize, Vec<f64>)> = Vec::with_capacity(lib.takes.len());
         for t in &lib.takes {
@@ -130,6 +131,11 @@ impl Sections {
                 (0..pos.frames()).map(|f| pos.frame(f).to_vec()).collect();
             let speed = smoothed_hand_speed(&hands, t.motion.fps());
             beats.extend(speed_minima(&speed).into_iter().map(|b| frames.len() + b));
+            peaks.extend(
+                speed_peaks(&speed, t.motion.fps())
+                    .into_iter()
+                    .map(|p| frames.len() + p),
+            );
             speeds.push((frames.len(), speed));
             let bound = rig
                 .bind(t.motion.skeleton(), &t.source.display().to_string())?
@@ -210,7 +216,8 @@ impl Sections {
                 )?,
             )?
             .with_calm(&calm)
-            .with_energy(&energy),
+            .with_energy(&energy)
+            .with_peaks(&peaks),
             rig: OwnedRig::new(&rig.name, rig.period_us, &cals)?,
             skeleton,
             frames: n,

@@ -58,6 +58,8 @@ pub struct OwnedLibrary {
     pub calm: Vec<u8>,
     /// `i8` energy per segment.
     pub energy: Vec<u8>,
+    /// Stroke bitset over the frame table.
+    pub peaks: Vec<u8>,
     /// Rotation-group records.
     pub groups: Vec<u8>,
 }
@@ -90,6 +92,7 @@ impl OwnedLibrary {
             beats: &self.beats,
             calm: &self.calm,
             energy: &self.energy,
+            peaks: &self.peaks,
             groups: &self.groups,
         }
     }
@@ -98,6 +101,13 @@ impl OwnedLibrary {
     /// default) marked calm (the hands slow: where a deferred cut may fall).
     pub fn with_calm(mut self, calm: &[usize]) -> Self {
         self.calm = frame_bits(self.frames as usize, calm);
+        self
+    }
+
+    /// The same library with the frames `peaks` (indices into the frame table; none by
+    /// default) marked as strokes (prominent peaks of the hands' speed).
+    pub fn with_peaks(mut self, peaks: &[usize]) -> Self {
+        self.peaks = frame_bits(self.frames as usize, peaks);
         self
     }
 
@@ -179,6 +189,7 @@ impl OwnedLibrary {
             beats: frame_bits(frames.len(), beats),
             calm: frame_bits(frames.len(), &[]),
             energy: alloc::vec![0u8; segments.len()],
+            peaks: frame_bits(frames.len(), &[]),
             groups: groups
                 .iter()
                 .map(|&(first, order)| {
