@@ -60,9 +60,11 @@
 //! written where they stay, so construction needs only a few KiB of stack beyond the controller
 //! itself (measured on a Cortex-M4F by `boards/qemu-m4/report`).
 
+mod ahead;
 mod build;
 mod event;
 mod labels;
+mod settings;
 
 use crate::blob::Blob;
 use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
@@ -71,11 +73,12 @@ use crate::inference::{
 };
 use crate::player::{LibraryFrames, Player, PlayerCommand, MAX_CHANNELS};
 use crate::policy::{
-    select_labelled, select_styled, Choice, History, Penalties, PolicyTables, Style, StyleError,
-    Variety, Visit,
+    select_labelled, select_styled, Choice, History, Penalties, PolicyTables, Style, Variety, Visit,
 };
 
 pub use crate::policy::{DecisionTiming, MAX_LABELLED, MAX_LABELS};
+use ahead::{Ahead, VoiceItem};
+pub use ahead::{Lookahead, MAX_LOOKAHEAD_MS};
 pub use event::{ControllerError, ControllerEvent, LabelOutcome};
 use labels::Labels;
 pub use labels::{LabelError, LABEL_QUEUE};
@@ -153,6 +156,8 @@ pub struct Controller<
     rest: RestSet,
     /// Length of a pause step (ms).
     pause_ms: u32,
+    /// Audio heard before it is played (see [`Lookahead`]).
+    ahead: Ahead,
 }
 
 impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'a, T, L, A> {
@@ -198,6 +203,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             voice: Voice::new(),
             rest: RestSet::EMPTY,
             pause_ms: config.syllables.pause_frames.saturating_mul(10),
+            ahead: Ahead::new(),
         });
         if let Err(e) = me.front_end.configure(config) {
             *slot = None;
@@ -230,113 +236,6 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         }
     }
 
-    /// The policy tables the controller decides with (for a blob controller, the blob).
-    pub fn tables(&self) -> &'a T {
-        self.tables
-    }
-
-    /// The current belief (uniform before the first step).
-    pub fn belief(&self) -> &[f32] {
-        let s = self.tables.states();
-        if self.belief.steps() == 0 {
-            &self.uniform[..s]
-        } else {
-            self.belief.probs(s)
-        }
-    }
-
-    /// Makes every decision use `belief` (one value per state) instead of the CRF's, or the
-    /// CRF's again with `None`. The belief still evolves and is reported; only the choice
-    /// ignores it. For evaluations (the "belief held at the prior" ablation); a `belief` of
-    /// another length is ignored.
-    pub fn hold_belief(&mut self, belief: Option<&[f32]>) {
-        self.held_belief = belief.filter(|b| b.len() == self.tables.states()).map(|b| {
-            let mut h = [0.0; MAX_STATES];
-            h[..b.len()].copy_from_slice(b);
-            h
-        });
-    }
-
-    /// Sets how the character follows the voice (the default is the blob's; docs in
-    /// [`crate::follow`]).
-    pub fn set_follow(&mut self, follow: VoiceFollow) {
-        self.follow = follow;
-        self.rest = if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
-            RestSet::of(self.tables, self.lib.segment_count())
-        } else {
-            RestSet::EMPTY
-        };
-    }
-
-    /// How the character follows the voice.
-    pub fn follow(&self) -> VoiceFollow {
-        self.follow
-    }
-
-    /// Whether the character rests (the speech has been silent for the blob's `rest_ms`).
-    pub fn resting(&self) -> bool {
-        self.voice.resting()
-    }
-
-    /// Sets how decisions vary (the default is the blob's).
-    pub fn set_variety(&mut self, variety: Variety) {
-        self.variety = variety;
-    }
-
-    /// How decisions vary.
-    pub fn variety(&self) -> Variety {
-        self.variety
-    }
-
-    /// Sets the style: one weight per tone of the tables (in their order; fewer weights leave
-    /// the rest at 0), applied from the next decision on. See [`Style::new`] for the rules;
-    /// an empty slice is the neutral style. On an error the style in force is kept.
-    pub fn set_style(&mut self, weights: &[f32]) -> Result<(), StyleError> {
-        if weights.len() > self.tables.tones() {
-            return Err(StyleError::TooManyWeights {
-                given: weights.len().min(u32::MAX as usize) as u32,
-                tones: self.tables.tones() as u32,
-            });
-        }
-        self.style = Style::new(weights)?;
-        Ok(())
-    }
-
-    /// The style in force.
-    pub fn style(&self) -> &Style {
-        &self.style
-    }
-
-    /// Asks for the semantic label `label` (0-based, the blob's order; docs/method.md
-    /// "Semantic labels"): from the next exit point on, the controller prefers the segments
-    /// carrying it and may enter one just before its stroke; the label is served once that
-    /// stroke plays, or dropped after the blob's timeout. A label that arrives while another
-    /// is served waits (at most [`LABEL_QUEUE`]). Reports `Received` through the next call's
-    /// events.
-    pub fn push_label(&mut self, label: usize) -> Result<(), LabelError> {
-        self.labels.push(label, self.tables.labels(), self.ticks)
-    }
-
-    /// Drops the label being served and every waiting one.
-    pub fn clear_labels(&mut self) {
-        self.labels.clear();
-    }
-
-    /// The label being served (0-based), if any.
-    pub fn active_label(&self) -> Option<usize> {
-        self.labels.active()
-    }
-
-    /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).
-    pub fn set_timing(&mut self, timing: DecisionTiming) {
-        self.timing = timing;
-    }
-
-    /// When decisions happen.
-    pub fn timing(&self) -> DecisionTiming {
-        self.timing
-    }
-
     /// Whether `ticks` ticks last at least `ms` milliseconds.
     fn ticks_reach_ms(&self, ticks: u64, ms: u32) -> bool {
         // ticks / (fps_milli / 1000) * 1000 >= ms
@@ -352,8 +251,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     /// Feeds samples; reports frames, steps with beliefs, decisions and poses through `sink`.
     pub fn push(&mut self, samples: &[i16], sink: &mut impl FnMut(ControllerEvent<'_>)) {
         let mut rest = samples;
+        let lead = self.ahead.lead_samples;
         while !rest.is_empty() {
-            let due = self.due(self.ticks);
+            let due = self.due(self.ticks) + lead;
             if self.samples >= due {
                 self.tick(sink);
                 continue;
@@ -363,7 +263,16 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             self.feed(now, sink);
             rest = later;
         }
-        if self.samples >= self.due(self.ticks) {
+        if self.samples >= self.due(self.ticks) + lead {
+            self.tick(sink);
+        }
+    }
+
+    /// Plays the ticks still due for the audio heard so far, which look-ahead holds back (at
+    /// the end of a known recording, after [`finish`](Self::finish)); without look-ahead
+    /// there are none.
+    pub fn drain(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        while self.samples >= self.due(self.ticks) && self.ticks < u64::MAX {
             self.tick(sink);
         }
     }
@@ -397,16 +306,30 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         );
         let (last_onset, now) = (&mut self.last_onset, self.ticks);
         let (voice, follow, pause_ms) = (&mut self.voice, &self.follow, self.pause_ms);
+        let (ahead, fps_milli) = (&mut self.ahead, self.fps_milli);
         let mut on_event = |ev| match ev {
             Event::Frame(f) => sink(ControllerEvent::Frame(f)),
             Event::Onset(frame) => {
-                *last_onset = Some(now);
-                voice.onset();
+                let (sync, hear) = ahead.onset(frame, now, fps_milli);
+                if sync {
+                    *last_onset = Some(now);
+                }
+                if hear {
+                    voice.onset();
+                }
                 sink(ControllerEvent::Onset(frame));
             }
             Event::Step(step) => {
                 let x = normalizer.push(&step);
-                voice.step(follow, x.pause, x.obs[0], pause_ms);
+                let item = VoiceItem::Step {
+                    pause: x.pause,
+                    level: x.obs[0],
+                };
+                if let Some(VoiceItem::Step { pause, level }) =
+                    ahead.step(step.end_frame, now, fps_milli, item)
+                {
+                    voice.step(follow, pause, level, pause_ms);
+                }
                 let mut m = [0.0f32; MAX_CLUSTERS];
                 memberships(&gmm[..clusters], &x, &mut m);
                 belief.step(crf, &m);
@@ -429,6 +352,18 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     }
 
     fn tick(&mut self, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        // What the look-ahead heard for this tick takes effect now.
+        while let Some(item) = self.ahead.due_voice(self.ticks) {
+            match item {
+                VoiceItem::Step { pause, level } => {
+                    self.voice.step(&self.follow, pause, level, self.pause_ms)
+                }
+                VoiceItem::Onset => self.voice.onset(),
+            }
+        }
+        if let Some(t) = self.ahead.due_onset(self.ticks) {
+            self.last_onset = Some(t);
+        }
         let segment = self.player.segment();
         let t = self.timing;
         let fresh = !t.sync_to_onsets
@@ -444,11 +379,12 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         let hold = at_beat && !fresh && !self.ticks_reach_ms(self.holding + 1, t.beat_hold_ms);
         self.holding = if hold { self.holding + 1 } else { 0 };
         let rate = self.player.rate();
-        self.player.set_rate(if self.voice.resting() {
+        let new_rate = if self.voice.resting() {
             crate::follow::rest_rate(self.tables.energy(segment))
         } else {
-            1.0
-        });
+            self.ahead.stroke_rate(self.lib, &self.player, self.ticks)
+        };
+        self.player.set_rate(new_rate);
         if self.player.rate() != rate {
             let command = PlayerCommand::Rate(self.player.rate());
             sink(ControllerEvent::Play {

@@ -36,9 +36,10 @@
 //! controller waits for a syllable onset.
 //!
 //! **Playback rate.** [`Player::set_rate`] slows playback down to [`MIN_RATE`] (half the
-//! library's pace), interpolating between frames: the controller plays a calm segment slower
-//! while the character rests if the segment moves faster than a rest should
-//! ([`crate::follow::rest_rate`]).
+//! library's pace) or speeds it up to [`MAX_RATE`], interpolating between frames: the
+//! controller plays a calm segment slower while the character rests if the segment moves
+//! faster than a rest should ([`crate::follow::rest_rate`]), and with look-ahead it stretches
+//! or hurries a stroke's approach so the stroke lands on a coming syllable.
 //!
 //! Invariants: fixed memory (a few arrays of [`MAX_CHANNELS`] values), no allocation, no panics;
 //! every output value is finite (non-finite library values are replaced by the previous
@@ -70,6 +71,10 @@ pub const MAX_BLEND_STRETCH: u32 = 3;
 /// The slowest playback rate (frames per tick): half the library's pace. Calm motion at half
 /// speed still reads as breathing and drift; slower, it reads as slow motion.
 pub const MIN_RATE: f32 = 0.5;
+
+/// The fastest playback rate (frames per tick): half again the library's pace, reached only
+/// on a stroke's approach when look-ahead lands it on a syllable.
+pub const MAX_RATE: f32 = 1.5;
 
 /// A phase this close to a whole frame counts as one (so a rate of 1 never interpolates).
 const RATE_EPSILON: f32 = 1.0e-4;
@@ -135,7 +140,7 @@ pub struct Player {
     /// Fastest the offset may move (degrees per tick at its start; 0: no cap).
     speed_cap: f32,
     blending: bool,
-    /// Frames advanced per tick ([`MIN_RATE`]..=1).
+    /// Frames advanced per tick ([`MIN_RATE`]..=[`MAX_RATE`]).
     rate: f32,
     /// How far playback stands between `frame` and the next frame (0..1).
     phase: f32,
@@ -178,16 +183,23 @@ impl Player {
         self.backward
     }
 
-    /// Plays `rate` frames per tick from the next tick on, clamped to [`MIN_RATE`]..=1 (1:
+    /// Plays `rate` frames per tick from the next tick on, clamped to
+    /// [`MIN_RATE`]..=[`MAX_RATE`] (1:
     /// the library's own pace; a non-finite rate is 1). Between frames the pose is
     /// interpolated linearly (a channel whose two frames are more than 180 degrees apart, a
     /// wrap, holds the earlier frame), so slower playback stays smooth.
     pub fn set_rate(&mut self, rate: f32) {
         self.rate = if rate.is_finite() {
-            rate.clamp(MIN_RATE, 1.0)
+            rate.clamp(MIN_RATE, MAX_RATE)
         } else {
             1.0
         };
+    }
+
+    /// Where playback stands within the segment: the next frame plus the phase towards the one
+    /// after it.
+    pub fn position(&self) -> f32 {
+        self.frame as f32 + self.phase
     }
 
     /// Frames advanced per tick.
@@ -587,9 +599,12 @@ mod tests {
         // At the first frame it turns forward by itself (shown once, as the turn).
         assert!(!p.backward());
         assert_eq!(play(&mut p)[..2], [5.0, 10.0]);
-        // Rates are clamped to MIN_RATE..=1; a non-finite one is 1. Entering plays forward.
+        // Rates are clamped to MIN_RATE..=MAX_RATE; a non-finite one is 1. Entering plays
+        // forward.
         p.set_rate(0.1);
         assert_eq!(p.rate(), MIN_RATE);
+        p.set_rate(7.0);
+        assert_eq!(p.rate(), MAX_RATE);
         p.set_rate(f32::NAN);
         assert_eq!(p.rate(), 1.0);
         p.turn();

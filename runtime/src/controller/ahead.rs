@@ -1,0 +1,305 @@
+//! Known audio: the controller hears the speech `ms` milliseconds before it is played
+//! ([`Lookahead`]; docs/method.md "Known audio").
+//!
+//! A robot that speaks with text-to-speech, a show that plays a recording, an animator with a
+//! recorded line: the audio exists before anyone hears it. Fed `L` ms early (the board delays
+//! its own playback by `L`, or the host feeds a file ahead), the controller plays each tick
+//! `L` ms of samples after the audio it has heard (tick `k` is due once `due(k) + L` samples
+//! have arrived), so what the front-end reports about the played moment comes early, not
+//! about 0.09 s late. Three things use it, each at the speech's own time rather than when the
+//! front-end reported it:
+//!
+//! - **Onsets** count for the decisions ([`crate::policy::DecisionTiming`]) at the tick their
+//!   syllable starts, so new gestures start with the syllables rather than a detection delay
+//!   after them.
+//! - **The voice** ([`crate::follow`]: pause steps counting towards rest, the speech's return)
+//!   acts `voice_lead_ms` before the speech does: the hands settle as the pause begins and
+//!   prepare as a speaker's do, just before the first syllable.
+//! - **Strokes land on syllables.** When the playing segment's next stroke (`library.peaks`)
+//!   lies within the look-ahead, the syllable onset nearest to where it would fall (within
+//!   `stroke_shift_ms`) becomes its target, and the approach to the stroke is played at the
+//!   rate that brings the stroke there: `rate = (stroke - position) / (target - now)`,
+//!   recomputed every tick and kept within the player's `MIN_RATE..=MAX_RATE`. A speaker does
+//!   the same (the preparation stretches or a pre-stroke hold waits, so the stroke meets the
+//!   stressed syllable: McNeill's phonological synchrony rule); the shift is at most a few
+//!   frames, spread over the approach.
+//!
+//! The belief steps as soon as a step is reported (the choice of segment uses what is known of
+//! the coming speech). With `ms = 0` nothing is delayed and everything happens exactly as in
+//! live mode. Memory is fixed: two small queues ([`PENDING`], [`ONSETS`]); when one is full the
+//! oldest item takes effect at once, so nothing is lost.
+
+use heapless::Deque;
+
+use crate::player::{LibraryFrames, Player, MAX_RATE, MIN_RATE};
+
+/// The longest look-ahead (ms): a second of speech.
+pub const MAX_LOOKAHEAD_MS: u32 = 1000;
+
+/// Voice effects (pause steps, onsets) waiting for their time.
+pub const PENDING: usize = 24;
+
+/// Syllable onsets known ahead of the played time.
+pub const ONSETS: usize = 16;
+
+/// How the controller uses audio it hears before it is played.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Lookahead {
+    /// How long before it is played the audio arrives (ms, 0..=[`MAX_LOOKAHEAD_MS`]; 0: live).
+    pub ms: u32,
+    /// How long before the speech the voice acts (ms; at most `ms`).
+    pub voice_lead_ms: u32,
+    /// How far a stroke may be moved to meet a syllable onset (ms; 0: strokes are not moved).
+    pub stroke_shift_ms: u32,
+}
+
+impl Lookahead {
+    /// Live: the audio is played as it is heard.
+    pub const LIVE: Self = Self {
+        ms: 0,
+        voice_lead_ms: 0,
+        stroke_shift_ms: 0,
+    };
+
+    /// `ms` of look-ahead (clamped to [`MAX_LOOKAHEAD_MS`]) with the default voice lead
+    /// (250 ms) and stroke shift (200 ms: most of the gap between two syllables at 3-4 per
+    /// second, so nearly every stroke finds one).
+    pub const fn ms(ms: u32) -> Self {
+        let ms = if ms > MAX_LOOKAHEAD_MS {
+            MAX_LOOKAHEAD_MS
+        } else {
+            ms
+        };
+        Self {
+            ms,
+            voice_lead_ms: 250,
+            stroke_shift_ms: 200,
+        }
+    }
+}
+
+impl Default for Lookahead {
+    fn default() -> Self {
+        Self::LIVE
+    }
+}
+
+/// A voice effect waiting for its tick.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum VoiceItem {
+    /// A step: pause or syllable, and the syllable's level.
+    Step { pause: bool, level: f32 },
+    /// A syllable onset.
+    Onset,
+}
+
+/// A stroke aimed at an onset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Aim {
+    segment: usize,
+    stroke: usize,
+    /// Tick the stroke is to be shown at (`None`: no onset in reach).
+    at: Option<u64>,
+}
+
+/// The look-ahead's state (see the module docs).
+#[derive(Clone, Debug)]
+pub(super) struct Ahead {
+    settings: Lookahead,
+    /// Samples of look-ahead.
+    pub(super) lead_samples: u64,
+    /// Ticks the voice acts early, ticks a stroke may move, ticks ahead a stroke is looked for.
+    voice_lead: u64,
+    shift: u64,
+    horizon: usize,
+    pending: Deque<(u64, VoiceItem), PENDING>,
+    onsets: Deque<u64, ONSETS>,
+    aim: Option<Aim>,
+}
+
+/// The tick at which 10 ms frame `frame` starts, at `fps_milli` thousandths of a frame per
+/// second (rounded to the nearest tick).
+fn frame_tick(frame: u32, fps_milli: u64) -> u64 {
+    (frame as u64 * fps_milli + 50_000) / 100_000
+}
+
+/// Ticks in `ms` (rounded down).
+fn ms_ticks(ms: u32, fps_milli: u64) -> u64 {
+    ms as u64 * fps_milli / 1_000_000
+}
+
+impl Ahead {
+    pub(super) const fn new() -> Self {
+        Self {
+            settings: Lookahead::LIVE,
+            lead_samples: 0,
+            voice_lead: 0,
+            shift: 0,
+            horizon: 0,
+            pending: Deque::new(),
+            onsets: Deque::new(),
+            aim: None,
+        }
+    }
+
+    pub(super) fn settings(&self) -> Lookahead {
+        self.settings
+    }
+
+    /// Sets the look-ahead for `rate` Hz and `fps_milli`; what was pending stays pending.
+    pub(super) fn set(&mut self, l: Lookahead, rate: u64, fps_milli: u64) {
+        let l = Lookahead {
+            ms: l.ms.min(MAX_LOOKAHEAD_MS),
+            voice_lead_ms: l.voice_lead_ms.min(l.ms.min(MAX_LOOKAHEAD_MS)),
+            stroke_shift_ms: l.stroke_shift_ms.min(MAX_LOOKAHEAD_MS),
+        };
+        self.settings = l;
+        self.lead_samples = l.ms as u64 * rate / 1000;
+        self.voice_lead = ms_ticks(l.voice_lead_ms, fps_milli);
+        self.shift = if l.ms > 0 {
+            ms_ticks(l.stroke_shift_ms, fps_milli)
+        } else {
+            0
+        };
+        // A stroke is looked for as far ahead as onsets are known: the look-ahead less the
+        // front-end's report delay (about 0.1 s).
+        self.horizon = ms_ticks(l.ms.saturating_sub(100), fps_milli) as usize;
+        self.aim = None;
+    }
+
+    /// An onset at 10 ms frame `frame` reported while tick `now` is due next: returns whether
+    /// it counts for decisions now and whether the voice hears it now (else it is queued).
+    pub(super) fn onset(&mut self, frame: u32, now: u64, fps_milli: u64) -> (bool, bool) {
+        if self.lead_samples == 0 {
+            return (true, true);
+        }
+        let t = frame_tick(frame, fps_milli);
+        let sync_now = t <= now || {
+            if self.onsets.is_full() {
+                self.onsets.pop_front();
+            }
+            self.onsets.push_back(t).is_err()
+        };
+        let voice_now = !self.queue(t.saturating_sub(self.voice_lead), now, VoiceItem::Onset);
+        (sync_now, voice_now)
+    }
+
+    /// A step ending at 10 ms frame `end` reported while tick `now` is due next: returns it if
+    /// the voice takes it now, else queues it.
+    pub(super) fn step(
+        &mut self,
+        end: u32,
+        now: u64,
+        fps_milli: u64,
+        item: VoiceItem,
+    ) -> Option<VoiceItem> {
+        if self.lead_samples == 0 {
+            return Some(item);
+        }
+        let at = frame_tick(end, fps_milli).saturating_sub(self.voice_lead);
+        (!self.queue(at, now, item)).then_some(item)
+    }
+
+    /// Queues `item` for tick `at` if that is after `now`; returns whether it was queued (with
+    /// the queue full it is not: the caller takes it now).
+    fn queue(&mut self, at: u64, now: u64, item: VoiceItem) -> bool {
+        if at <= now || self.pending.is_full() {
+            return false;
+        }
+        self.pending.push_back((at, item)).is_ok()
+    }
+
+    /// The next voice effect due by tick `now`, oldest first.
+    pub(super) fn due_voice(&mut self, now: u64) -> Option<VoiceItem> {
+        match self.pending.front() {
+            Some(&(at, _)) if at <= now => self.pending.pop_front().map(|(_, v)| v),
+            _ => None,
+        }
+    }
+
+    /// The latest onset due by tick `now` (removing those due).
+    pub(super) fn due_onset(&mut self, now: u64) -> Option<u64> {
+        let mut last = None;
+        while let Some(&t) = self.onsets.front() {
+            if t > now {
+                break;
+            }
+            last = Some(t);
+            self.onsets.pop_front();
+        }
+        last
+    }
+
+    /// The playback rate that lands the playing segment's next stroke on a syllable onset
+    /// (1 when there is none in reach, or without look-ahead).
+    pub(super) fn stroke_rate<L: LibraryFrames + ?Sized>(
+        &mut self,
+        lib: &L,
+        player: &Player,
+        now: u64,
+    ) -> f32 {
+        if self.shift == 0 || self.horizon == 0 || player.backward() {
+            self.aim = None;
+            return 1.0;
+        }
+        let seg = player.segment();
+        let pos = player.position();
+        let aim = match self.aim {
+            // Kept while it has an onset; without one, looked for again (onsets keep coming).
+            Some(a) if a.segment == seg && a.stroke as f32 > pos && a.at.is_some() => a,
+            _ => {
+                let a = self.aim_at(lib, seg, player.frame(), pos, now);
+                self.aim = a;
+                match a {
+                    Some(a) => a,
+                    None => return 1.0,
+                }
+            }
+        };
+        match aim.at {
+            Some(at) if at > now => {
+                let r = (aim.stroke as f32 - pos) / (at - now) as f32;
+                r.clamp(MIN_RATE, MAX_RATE)
+            }
+            _ => 1.0,
+        }
+    }
+
+    /// The next stroke of segment `seg` after position `pos` (frame `frame` next) within the
+    /// horizon, aimed at the known onset nearest to where it falls at the library's pace (if
+    /// one is within the shift and reachable within the player's rates); `None` if no stroke
+    /// is in the horizon.
+    fn aim_at<L: LibraryFrames + ?Sized>(
+        &self,
+        lib: &L,
+        seg: usize,
+        frame: usize,
+        pos: f32,
+        now: u64,
+    ) -> Option<Aim> {
+        let len = lib.segment_len(seg);
+        let last = frame.saturating_add(self.horizon).min(len);
+        let stroke = (frame..last).find(|&f| f as f32 > pos && lib.is_peak(seg, f))?;
+        let ahead = stroke as f32 - pos;
+        let natural = now as f32 + ahead;
+        let mut best: Option<(u64, f32)> = None;
+        for &t in self.onsets.iter() {
+            if t <= now {
+                continue;
+            }
+            let d = (t as f32 - natural).abs();
+            let rate = ahead / (t - now) as f32;
+            if d <= self.shift as f32
+                && (MIN_RATE..=MAX_RATE).contains(&rate)
+                && best.is_none_or(|(_, bd)| d < bd)
+            {
+                best = Some((t, d));
+            }
+        }
+        Some(Aim {
+            segment: seg,
+            stroke,
+            at: best.map(|(t, _)| t),
+        })
+    }
+}
