@@ -20,6 +20,7 @@ use crate::live::{self, LiveOptions};
 use crate::run::{self as run_cmd, RunConfig, RunError};
 use crate::style::StyleFlags;
 use crate::{bench, eval_cmd, prosody_cmd};
+use gesture_trainer::evaluate::motion::Horizon;
 
 /// Runs the gesture-controller runtime on the desktop.
 #[derive(Debug, Parser)]
@@ -88,6 +89,11 @@ pub enum Command {
         /// Audio chunk length in ms (how often the device would process samples).
         #[arg(long, default_value_t = 10.0, value_parser = parse_chunk_ms)]
         chunk_ms: f64,
+        /// Known audio: the controller hears the speech this many ms (0-1000) before it is
+        /// played, or `all` for the whole file (a recording, text-to-speech): strokes land on
+        /// syllables, hands settle and prepare with the speech.
+        #[arg(long, value_name = "MS|all", default_value = "0", value_parser = clap::value_parser!(Horizon))]
+        lookahead_ms: Horizon,
         /// Do not write preview.mp4 (the video with the speech, made with ffmpeg).
         #[arg(long)]
         no_video: bool,
@@ -267,6 +273,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             rig,
             realtime,
             chunk_ms,
+            lookahead_ms,
             no_video,
             vmc,
             bone_map,
@@ -285,6 +292,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 rig: rig.clone(),
                 realtime: *realtime,
                 chunk_ms: *chunk_ms,
+                lookahead: *lookahead_ms,
                 video: !*no_video,
                 vmc: vmc.clone(),
                 bone_map: bone_map.clone(),

@@ -394,6 +394,7 @@ fn simulate(
         rig: None,
         realtime: false,
         chunk_ms: 10.0,
+        lookahead: gesture_trainer::evaluate::motion::Horizon::Ms(0),
         // The video of the characters (with ffmpeg); the puppets' would show the same runs.
         video,
         vmc: None,

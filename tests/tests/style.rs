@@ -84,6 +84,7 @@ fn bandai_tones_restyle_a_zeroeggs_library_on_new_speech() {
             styles,
             ..PackOptions::default()
         },
+        lookahead: Vec::new(),
     };
     let specs: Vec<String> = [
         "neutral",

@@ -52,6 +52,7 @@ use gesture_trainer::motion::write_bvh;
 use gesture_trainer::rig::{Rig, RigError};
 
 use gesture_trainer::evaluate::metrics::entries_from_frames;
+use gesture_trainer::evaluate::motion::Horizon;
 use gesture_trainer::rig::PoseSkeleton;
 use sim::{median_max, simulate, SimOptions, Simulation};
 
@@ -70,6 +71,8 @@ pub struct RunConfig {
     pub realtime: bool,
     /// Audio chunk length (ms).
     pub chunk_ms: f64,
+    /// How long before it is played the controller hears the audio.
+    pub lookahead: Horizon,
     /// Write `preview.mp4` (when `ffmpeg` is on `PATH`).
     pub video: bool,
     /// Stream the poses over VMC to this `HOST:PORT` ([`crate::vmc`]).
@@ -503,6 +506,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
             chunk,
             // With --vmc or --ros2 the poses are paced as they are sent instead.
             realtime: cfg.realtime && vmc.is_none() && publisher.is_none(),
+            lookahead: cfg.lookahead.lookahead(),
         },
         &styles,
         &labels,

@@ -15,7 +15,7 @@
 use std::time::{Duration, Instant};
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{BlobController, ControllerEvent, LabelOutcome};
+use gesture_runtime::controller::{BlobController, ControllerEvent, LabelOutcome, Lookahead};
 use gesture_runtime::device::{Device, DeviceEvent};
 use gesture_runtime::player::PlayerCommand;
 use gesture_runtime::policy::Choice;
@@ -208,6 +208,8 @@ pub struct SimOptions {
     pub chunk: usize,
     /// Pace the chunks on the wall clock.
     pub realtime: bool,
+    /// How long before it is played the controller hears the audio.
+    pub lookahead: Lookahead,
 }
 
 /// Splits `samples` into chunks of `chunk`, and also at every sample index in `cuts` (sorted):
@@ -260,6 +262,7 @@ pub fn simulate(
         Some((cals, period_us)),
     )
     .map_err(|e| e.to_string())?;
+    device.controller_mut().set_lookahead(opts.lookahead);
     let rate = blob.prosody_config().sample_rate_hz;
     let mut sim = Simulation {
         sample_rate_hz: rate,
@@ -323,6 +326,8 @@ pub fn simulate(
     }
     let now_s = pushed as f64 / rate as f64;
     let _ = device.finish(&mut |e| record(&mut sim, blob, channels, now_s, true, style, e));
+    // With look-ahead, the end of the recording is played after it was heard.
+    let _ = device.drain(&mut |e| record(&mut sim, blob, channels, now_s, true, style, e));
     if sim.styles.is_empty() {
         sim.styles.push(StyleChange {
             time_s: 0.0,

@@ -31,7 +31,7 @@
 
 use heapless::Deque;
 
-use crate::player::{LibraryFrames, Player, MAX_RATE, MIN_RATE};
+use crate::player::{LibraryFrames, Player};
 
 /// The longest look-ahead (ms): a second of speech.
 pub const MAX_LOOKAHEAD_MS: u32 = 1000;
@@ -41,6 +41,17 @@ pub const PENDING: usize = 24;
 
 /// Syllable onsets known ahead of the played time.
 pub const ONSETS: usize = 16;
+
+/// The slowest and fastest pace of a stroke's approach: a stroke is moved to an onset only if
+/// a steady rate within these brings it there.
+pub const WARP_MIN: f32 = 0.7;
+/// See [`WARP_MIN`].
+pub const WARP_MAX: f32 = 1.35;
+
+/// How fast the stroke's playback rate changes (rate units per second): an abrupt change of
+/// pace is a kick in the hands' acceleration; at this slew a change of a third takes a fifth
+/// of a second.
+pub const RATE_SLEW_PER_S: f32 = 1.0;
 
 /// How the controller uses audio it hears before it is played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -100,6 +111,8 @@ struct Aim {
     stroke: usize,
     /// Tick the stroke is to be shown at (`None`: no onset in reach).
     at: Option<u64>,
+    /// The rate that brings it there (1 without an onset).
+    rate: f32,
 }
 
 /// The look-ahead's state (see the module docs).
@@ -115,6 +128,9 @@ pub(super) struct Ahead {
     pending: Deque<(u64, VoiceItem), PENDING>,
     onsets: Deque<u64, ONSETS>,
     aim: Option<Aim>,
+    /// The rate given last (slewed towards the next), and the largest change per tick.
+    rate: f32,
+    slew: f32,
 }
 
 /// The tick at which 10 ms frame `frame` starts, at `fps_milli` thousandths of a frame per
@@ -139,6 +155,8 @@ impl Ahead {
             pending: Deque::new(),
             onsets: Deque::new(),
             aim: None,
+            rate: 1.0,
+            slew: 0.0,
         }
     }
 
@@ -165,6 +183,8 @@ impl Ahead {
         // front-end's report delay (about 0.1 s).
         self.horizon = ms_ticks(l.ms.saturating_sub(100), fps_milli) as usize;
         self.aim = None;
+        self.rate = 1.0;
+        self.slew = RATE_SLEW_PER_S * 1000.0 / fps_milli.max(1) as f32;
     }
 
     /// An onset at 10 ms frame `frame` reported while tick `now` is due next: returns whether
@@ -240,8 +260,21 @@ impl Ahead {
     ) -> f32 {
         if self.shift == 0 || self.horizon == 0 || player.backward() {
             self.aim = None;
+            self.rate = 1.0;
             return 1.0;
         }
+        let want = self.wanted_rate(lib, player, now);
+        self.rate = want.clamp(self.rate - self.slew, self.rate + self.slew);
+        self.rate
+    }
+
+    /// The rate that lands the aimed stroke on its onset, before the slew.
+    fn wanted_rate<L: LibraryFrames + ?Sized>(
+        &mut self,
+        lib: &L,
+        player: &Player,
+        now: u64,
+    ) -> f32 {
         let seg = player.segment();
         let pos = player.position();
         let aim = match self.aim {
@@ -256,13 +289,7 @@ impl Ahead {
                 }
             }
         };
-        match aim.at {
-            Some(at) if at > now => {
-                let r = (aim.stroke as f32 - pos) / (at - now) as f32;
-                r.clamp(MIN_RATE, MAX_RATE)
-            }
-            _ => 1.0,
-        }
+        aim.rate
     }
 
     /// The next stroke of segment `seg` after position `pos` (frame `frame` next) within the
@@ -282,7 +309,7 @@ impl Ahead {
         let stroke = (frame..last).find(|&f| f as f32 > pos && lib.is_peak(seg, f))?;
         let ahead = stroke as f32 - pos;
         let natural = now as f32 + ahead;
-        let mut best: Option<(u64, f32)> = None;
+        let mut best: Option<(u64, f32, f32)> = None;
         for &t in self.onsets.iter() {
             if t <= now {
                 continue;
@@ -290,16 +317,17 @@ impl Ahead {
             let d = (t as f32 - natural).abs();
             let rate = ahead / (t - now) as f32;
             if d <= self.shift as f32
-                && (MIN_RATE..=MAX_RATE).contains(&rate)
-                && best.is_none_or(|(_, bd)| d < bd)
+                && (WARP_MIN..=WARP_MAX).contains(&rate)
+                && best.is_none_or(|(_, bd, _)| d < bd)
             {
-                best = Some((t, d));
+                best = Some((t, d, rate));
             }
         }
         Some(Aim {
             segment: seg,
             stroke,
-            at: best.map(|(t, _)| t),
+            at: best.map(|(t, _, _)| t),
+            rate: best.map_or(1.0, |(_, _, r)| r),
         })
     }
 }

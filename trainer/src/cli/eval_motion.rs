@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use super::args::{parse_span, ControlArgs, CorpusArgs, DeviceArgs};
 use super::exit::CliError;
 use crate::evaluate::metrics::MotionMetrics;
-use crate::evaluate::motion::{evaluate_motion, Evaluation, MotionEval};
+use crate::evaluate::motion::{evaluate_motion, Evaluation, Horizon, MotionEval};
 use crate::evaluate::table::motion_table;
 use crate::inference::model::InferenceModel;
 use crate::pack::PackOptions;
@@ -38,6 +38,11 @@ pub struct EvalMotionArgs {
     /// by 0.2 s more each time (the variety figures are of the first run).
     #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub device_runs: u64,
+    /// Add a row per look-ahead: the controller fed the audio that many ms before it is played
+    /// (`lookahead_<ms>`), or `all` for the whole file planned (`lookahead_all`); a list such
+    /// as `0,100,300,500,1000,all`.
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(Horizon))]
+    pub lookahead_ms: Vec<Horizon>,
     /// Print one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -71,6 +76,7 @@ impl EvalMotionArgs {
             random_runs: self.random_runs,
             device_runs: self.device_runs,
             pack,
+            lookahead: self.lookahead_ms.clone(),
         })
     }
 }

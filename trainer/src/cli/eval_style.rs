@@ -69,6 +69,7 @@ pub fn run(a: &EvalStyleArgs) -> Result<(), CliError> {
         random_runs: 1,
         device_runs: a.device_runs,
         pack,
+        lookahead: Vec::new(),
     };
     let model = InferenceModel::load(&a.model)?;
     let ev = evaluate_styles(&model, &settings, &a.styles)?;

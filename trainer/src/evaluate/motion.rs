@@ -51,7 +51,7 @@ use serde::Serialize;
 
 use super::error::EvalError;
 use super::metrics::{measure, MotionMetrics, Speech};
-use super::playback::{play_delayed, play_schedule, shuffle_blocks, Playback};
+use super::playback::{play_ahead, play_delayed, play_schedule, shuffle_blocks, Playback};
 use super::reference::{shown_speed_histogram, speech_matched_reference};
 use super::signals::speed_histogram;
 use super::trace::{entries_from_frames, Entry, Trace};
@@ -82,6 +82,56 @@ pub struct MotionEval {
     /// How to pack (costs, device settings, effectors); the rig is the library's full
     /// skeleton.
     pub pack: PackOptions,
+    /// Look-ahead rows to add (`lookahead_<ms>`, `lookahead_all`): the controller fed the
+    /// audio that long before it is played, or the whole file planned ([`Horizon`]).
+    pub lookahead: Vec<Horizon>,
+}
+
+/// How far ahead of its playback the speech is known.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Horizon {
+    /// The controller hears the audio this many ms before it is played.
+    Ms(u32),
+    /// The whole file is known: planned in advance (`gesture-sim run --lookahead-ms all`).
+    All,
+}
+
+impl std::str::FromStr for Horizon {
+    type Err = String;
+
+    /// Milliseconds (at most a second) or `all`.
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.trim() == "all" {
+            return Ok(Self::All);
+        }
+        let max = gesture_runtime::controller::MAX_LOOKAHEAD_MS;
+        match s.trim().parse::<u32>() {
+            Ok(ms) if ms <= max => Ok(Self::Ms(ms)),
+            _ => Err(format!(
+                "`{s}` is not a look-ahead: milliseconds from 0 to {max}, or `all`"
+            )),
+        }
+    }
+}
+
+impl Horizon {
+    /// The controller's look-ahead for this horizon (the whole file: the most the runtime
+    /// takes, a second).
+    pub fn lookahead(self) -> gesture_runtime::controller::Lookahead {
+        use gesture_runtime::controller::{Lookahead, MAX_LOOKAHEAD_MS};
+        match self {
+            Self::Ms(ms) => Lookahead::ms(ms),
+            Self::All => Lookahead::ms(MAX_LOOKAHEAD_MS),
+        }
+    }
+
+    /// The row's name.
+    pub fn row_name(self) -> String {
+        match self {
+            Self::Ms(ms) => format!("lookahead_{ms}"),
+            Self::All => "lookahead_all".into(),
+        }
+    }
 }
 
 /// One method's row.
@@ -374,6 +424,15 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
             ms.push(measured(&p)?);
         }
         rows.push(Row::of_runs(method.name(), &ms));
+    }
+    for &h in &e.lookahead {
+        progress.set_message(format!("eval-motion: {}", h.row_name()));
+        let mut ms = Vec::with_capacity(runs);
+        for run in 0..runs {
+            let p = play_ahead(&blob, &samples, rate, frames, run * step, h.lookahead())?;
+            ms.push(measured(&p)?);
+        }
+        rows.push(Row::of_runs(&h.row_name(), &ms));
     }
     // References, played by the same player.
     let start = 0;

@@ -4,7 +4,7 @@
 //! ([`shuffle_blocks`]). What was shown comes back as a [`Playback`].
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent, Lookahead};
 use gesture_runtime::device::{Device, DeviceEvent, NullPin};
 use gesture_runtime::player::{Player, MAX_CHANNELS};
 use gesture_runtime::policy::Choice;
@@ -78,6 +78,34 @@ pub(crate) fn play_online(
     });
     hold_to(&mut out, frames);
     Ok((out, made))
+}
+
+/// The device's motion on `samples` delayed by `delay` frames of silence (as
+/// [`play_delayed`]) with the controller hearing the audio `l.ms` before it is played: fed
+/// the samples followed by that much silence (after a recording, nothing), so every tick of
+/// the audio is played.
+pub(crate) fn play_ahead(
+    blob: &Blob<'_>,
+    samples: &[i16],
+    rate: u32,
+    frames: usize,
+    delay: usize,
+    mut l: Lookahead,
+) -> Result<Playback, EvalError> {
+    let mut input = samples.to_vec();
+    input.resize(
+        samples.len() + (l.ms as usize * rate as usize).div_ceil(1000),
+        0,
+    );
+    // TEMP experiment knobs.
+    if let Some(v) = std::env::var("LA_SHIFT").ok().and_then(|v| v.parse().ok()) {
+        l.stroke_shift_ms = v;
+    }
+    if let Some(v) = std::env::var("LA_VOICE").ok().and_then(|v| v.parse().ok()) {
+        l.voice_lead_ms = v;
+    }
+    let (p, _) = play_delayed(blob, &input, rate, frames, delay, |c| c.set_lookahead(l))?;
+    Ok(p)
 }
 
 /// Truncates or extends (repeating the last tick) a playback to `frames` ticks.
