@@ -192,7 +192,7 @@ pub fn stroke_frames(hands: &[Vec<Vec3>], fps: f64) -> Vec<usize> {
 /// [`stroke_frames`] of a smoothed hand speed `sp` (per frame, at `fps`).
 pub fn speed_peaks(sp: &[f64], fps: f64) -> Vec<usize> {
     let n = sp.len();
-    let min_prom = STROKE_PROMINENCE * quantile(&sp, 0.5);
+    let min_prom = STROKE_PROMINENCE * quantile(sp, 0.5);
     let reach = (STROKE_WINDOW_S * fps).round().max(1.0) as usize;
     let gap = (STROKE_GAP_S * fps).round() as usize;
     // Local maxima (the first frame of a plateau).
