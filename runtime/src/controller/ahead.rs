@@ -31,7 +31,7 @@
 
 use heapless::Deque;
 
-use crate::player::{LibraryFrames, Player};
+use crate::player::{LibraryFrames, Player, MAX_RATE, MIN_RATE};
 
 /// The longest look-ahead (ms): a second of speech.
 pub const MAX_LOOKAHEAD_MS: u32 = 1000;
@@ -44,14 +44,18 @@ pub const ONSETS: usize = 16;
 
 /// The slowest and fastest pace of a stroke's approach: a stroke is moved to an onset only if
 /// a steady rate within these brings it there.
-pub const WARP_MIN: f32 = 0.7;
+pub const WARP_MIN: f32 = 0.6;
 /// See [`WARP_MIN`].
-pub const WARP_MAX: f32 = 1.35;
+pub const WARP_MAX: f32 = 1.5;
 
 /// How fast the stroke's playback rate changes (rate units per second): an abrupt change of
 /// pace is a kick in the hands' acceleration; at this slew a change of a third takes a fifth
 /// of a second.
-pub const RATE_SLEW_PER_S: f32 = 1.0;
+pub const RATE_SLEW_PER_S: f32 = 2.0;
+
+/// How long the pace holds after a stroke (ms): about the smoothing over which a viewer (and
+/// `eval-motion`) sees the hands' speed peak.
+pub const STEADY_MS: u32 = 150;
 
 /// How the controller uses audio it hears before it is played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,8 +77,9 @@ impl Lookahead {
     };
 
     /// `ms` of look-ahead (clamped to [`MAX_LOOKAHEAD_MS`]) with the default voice lead
-    /// (250 ms) and stroke shift (200 ms: most of the gap between two syllables at 3-4 per
-    /// second, so nearly every stroke finds one).
+    /// (250 ms) and stroke shift (300 ms: the gap between two syllables at 3-4 per second, so
+    /// nearly every stroke finds one; 200 ms left more strokes off the syllables on tuning
+    /// speech).
     pub const fn ms(ms: u32) -> Self {
         let ms = if ms > MAX_LOOKAHEAD_MS {
             MAX_LOOKAHEAD_MS
@@ -84,7 +89,7 @@ impl Lookahead {
         Self {
             ms,
             voice_lead_ms: 250,
-            stroke_shift_ms: 200,
+            stroke_shift_ms: 300,
         }
     }
 }
@@ -109,10 +114,10 @@ pub(super) enum VoiceItem {
 struct Aim {
     segment: usize,
     stroke: usize,
-    /// Tick the stroke is to be shown at (`None`: no onset in reach).
+    /// Tick at which it falls at the library's pace, seen when it came in reach.
+    natural: f32,
+    /// Tick the stroke is to be shown at (`None`: no onset in reach yet).
     at: Option<u64>,
-    /// The rate that brings it there (1 without an onset).
-    rate: f32,
 }
 
 /// The look-ahead's state (see the module docs).
@@ -125,12 +130,17 @@ pub(super) struct Ahead {
     voice_lead: u64,
     shift: u64,
     horizon: usize,
+    /// Frames ahead a stroke is looked for: the look-ahead and the shift.
+    reach: usize,
     pending: Deque<(u64, VoiceItem), PENDING>,
     onsets: Deque<u64, ONSETS>,
     aim: Option<Aim>,
     /// The rate given last (slewed towards the next), and the largest change per tick.
     rate: f32,
     slew: f32,
+    /// Ticks the pace holds after a stroke, and until when it holds.
+    steady: u64,
+    steady_until: u64,
 }
 
 /// The tick at which 10 ms frame `frame` starts, at `fps_milli` thousandths of a frame per
@@ -152,11 +162,14 @@ impl Ahead {
             voice_lead: 0,
             shift: 0,
             horizon: 0,
+            reach: 0,
             pending: Deque::new(),
             onsets: Deque::new(),
             aim: None,
             rate: 1.0,
             slew: 0.0,
+            steady: 0,
+            steady_until: 0,
         }
     }
 
@@ -182,8 +195,11 @@ impl Ahead {
         // A stroke is looked for as far ahead as onsets are known: the look-ahead less the
         // front-end's report delay (about 0.1 s).
         self.horizon = ms_ticks(l.ms.saturating_sub(100), fps_milli) as usize;
+        self.reach = ms_ticks(l.ms.saturating_add(l.stroke_shift_ms), fps_milli) as usize;
         self.aim = None;
         self.rate = 1.0;
+        self.steady = ms_ticks(STEADY_MS, fps_milli);
+        self.steady_until = 0;
         self.slew = RATE_SLEW_PER_S * 1000.0 / fps_milli.max(1) as f32;
     }
 
@@ -263,6 +279,9 @@ impl Ahead {
             self.rate = 1.0;
             return 1.0;
         }
+        if now < self.steady_until {
+            return self.rate;
+        }
         let want = self.wanted_rate(lib, player, now);
         self.rate = want.clamp(self.rate - self.slew, self.rate + self.slew);
         self.rate
@@ -277,26 +296,57 @@ impl Ahead {
     ) -> f32 {
         let seg = player.segment();
         let pos = player.position();
-        let aim = match self.aim {
-            // Kept while it has an onset; without one, looked for again (onsets keep coming).
-            Some(a) if a.segment == seg && a.stroke as f32 > pos && a.at.is_some() => a,
-            _ => {
-                let a = self.aim_at(lib, seg, player.frame(), pos, now);
-                self.aim = a;
-                match a {
-                    Some(a) => a,
-                    None => return 1.0,
+        let mut aim = match self.aim {
+            Some(a) if a.segment == seg && a.stroke as f32 > pos => a,
+            _ => match self.next_stroke(lib, seg, player.frame(), pos, now) {
+                Some(a) => a,
+                None => {
+                    self.aim = None;
+                    return 1.0;
                 }
-            }
+            },
         };
-        aim.rate
+        if aim.at.is_some_and(|at| at <= now) {
+            // The stroke is shown: its pace holds a little longer, so the hands' speed peaks
+            // where the stroke is (a pace that changes at the stroke moves the peak).
+            self.steady_until = now + self.steady;
+            self.aim = None;
+            return self.rate;
+        }
+        // The onset nearest to where the stroke first fell, among those known by now (more
+        // become known as it comes closer) and reachable at a steady rate within the bounds.
+        let ahead = aim.stroke as f32 - pos;
+        let mut best: Option<(u64, f32)> = None;
+        for &t in self.onsets.iter() {
+            if t <= now {
+                continue;
+            }
+            let d = (t as f32 - aim.natural).abs();
+            let rate = ahead / (t - now) as f32;
+            if d <= self.shift as f32
+                && (WARP_MIN..=WARP_MAX).contains(&rate)
+                && best.is_none_or(|(_, bd)| d < bd)
+            {
+                best = Some((t, d));
+            }
+        }
+        // Once aimed, the target holds unless a nearer onset is reachable.
+        aim.at = match (aim.at, best) {
+            (Some(at), Some((_, d))) if (at as f32 - aim.natural).abs() <= d => Some(at),
+            (Some(at), None) => Some(at),
+            (_, b) => b.map(|(t, _)| t),
+        };
+        self.aim = Some(aim);
+        // Closed loop: the rate that brings the stroke to its tick from where playback stands.
+        match aim.at {
+            Some(at) => (ahead / (at - now) as f32).clamp(MIN_RATE, MAX_RATE),
+            None => 1.0,
+        }
     }
 
-    /// The next stroke of segment `seg` after position `pos` (frame `frame` next) within the
-    /// horizon, aimed at the known onset nearest to where it falls at the library's pace (if
-    /// one is within the shift and reachable within the player's rates); `None` if no stroke
-    /// is in the horizon.
-    fn aim_at<L: LibraryFrames + ?Sized>(
+    /// The next stroke of segment `seg` after position `pos` (frame `frame` next) that comes
+    /// within the look-ahead and the shift, not yet aimed.
+    fn next_stroke<L: LibraryFrames + ?Sized>(
         &self,
         lib: &L,
         seg: usize,
@@ -305,29 +355,87 @@ impl Ahead {
         now: u64,
     ) -> Option<Aim> {
         let len = lib.segment_len(seg);
-        let last = frame.saturating_add(self.horizon).min(len);
+        let last = frame.saturating_add(self.reach).min(len);
         let stroke = (frame..last).find(|&f| f as f32 > pos && lib.is_peak(seg, f))?;
-        let ahead = stroke as f32 - pos;
-        let natural = now as f32 + ahead;
-        let mut best: Option<(u64, f32, f32)> = None;
-        for &t in self.onsets.iter() {
-            if t <= now {
-                continue;
-            }
-            let d = (t as f32 - natural).abs();
-            let rate = ahead / (t - now) as f32;
-            if d <= self.shift as f32
-                && (WARP_MIN..=WARP_MAX).contains(&rate)
-                && best.is_none_or(|(_, bd, _)| d < bd)
-            {
-                best = Some((t, d, rate));
-            }
-        }
         Some(Aim {
             segment: seg,
             stroke,
-            at: best.map(|(t, _, _)| t),
-            rate: best.map_or(1.0, |(_, _, r)| r),
+            natural: now as f32 + (stroke as f32 - pos),
+            at: None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One segment of 100 frames at 30 fps whose stroke is frame 40.
+    struct Stroke;
+    impl LibraryFrames for Stroke {
+        fn channels(&self) -> usize {
+            1
+        }
+        fn fps(&self) -> f32 {
+            30.0
+        }
+        fn segment_count(&self) -> usize {
+            1
+        }
+        fn segment_len(&self, _: usize) -> usize {
+            100
+        }
+        fn value(&self, _: usize, f: usize, _: usize) -> f32 {
+            f as f32
+        }
+        fn is_peak(&self, _: usize, f: usize) -> bool {
+            f == 40
+        }
+    }
+
+    /// Plays `Stroke` from tick 0 with `ahead` steering the rate; the tick at which the
+    /// stroke frame is first reached.
+    fn stroke_tick(ahead: &mut Ahead) -> u64 {
+        let mut player = Player::new();
+        let mut out = [0.0; crate::player::MAX_CHANNELS];
+        for now in 0..100u64 {
+            let r = ahead.stroke_rate(&Stroke, &player, now);
+            player.set_rate(r);
+            player.tick(&Stroke, &mut out);
+            if out[0] >= 40.0 - 1e-3 {
+                return now;
+            }
+        }
+        u64::MAX
+    }
+
+    #[test]
+    fn a_stroke_lands_on_the_onset_in_reach_and_live_mode_leaves_it_alone() {
+        const FPS_MILLI: u64 = 30_000;
+        // Live: onsets count at once and the stroke plays at its own time, tick 40.
+        let mut live = Ahead::new();
+        live.set(Lookahead::LIVE, 16_000, FPS_MILLI);
+        assert_eq!(live.onset(153, 0, FPS_MILLI), (true, true));
+        assert_eq!(stroke_tick(&mut live), 40);
+        // A second of look-ahead: an onset at 1.53 s (tick 46), 200 ms after where the
+        // stroke would fall, is known from the start; the stroke lands on it.
+        let mut ahead = Ahead::new();
+        ahead.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
+        assert_eq!(ahead.onset(153, 0, FPS_MILLI), (false, false));
+        let t = stroke_tick(&mut ahead);
+        assert!(t.abs_diff(46) <= 1, "{t}");
+        // The onset counts for decisions at its own tick, the voice hears it 250 ms before.
+        assert_eq!(ahead.due_onset(45), None);
+        assert_eq!(ahead.due_onset(46), Some(46));
+        let mut early = Ahead::new();
+        early.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
+        early.onset(153, 0, FPS_MILLI);
+        assert_eq!(early.due_voice(38), None);
+        assert_eq!(early.due_voice(39), Some(VoiceItem::Onset));
+        // An onset further than the shift from the stroke leaves it where it is.
+        let mut far = Ahead::new();
+        far.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
+        far.onset(170, 0, FPS_MILLI); // tick 51: 367 ms late
+        assert_eq!(stroke_tick(&mut far), 40);
     }
 }

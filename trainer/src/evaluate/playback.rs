@@ -90,20 +90,13 @@ pub(crate) fn play_ahead(
     rate: u32,
     frames: usize,
     delay: usize,
-    mut l: Lookahead,
+    l: Lookahead,
 ) -> Result<Playback, EvalError> {
     let mut input = samples.to_vec();
     input.resize(
         samples.len() + (l.ms as usize * rate as usize).div_ceil(1000),
         0,
     );
-    // TEMP experiment knobs.
-    if let Some(v) = std::env::var("LA_SHIFT").ok().and_then(|v| v.parse().ok()) {
-        l.stroke_shift_ms = v;
-    }
-    if let Some(v) = std::env::var("LA_VOICE").ok().and_then(|v| v.parse().ok()) {
-        l.voice_lead_ms = v;
-    }
     let (p, _) = play_delayed(blob, &input, rate, frames, delay, |c| c.set_lookahead(l))?;
     Ok(p)
 }
