@@ -8,6 +8,11 @@
 //!
 //! ## The trace
 //!
+//! An input whose name ends in `-ahead` runs with [`LOOKAHEAD_MS`] of look-ahead (known
+//! audio: the controller hears it that long before it is played), followed by that much
+//! silence so every tick of the audio is played (`gesture-sim run --lookahead-ms` does the
+//! same).
+//!
 //! Per input: `input <name> samples=<n>`, then one line per decision
 //!
 //! ```text
@@ -43,7 +48,7 @@ use core::fmt::{self, Write};
 
 use embedded_hal::pwm::{ErrorType, SetDutyCycle};
 use gesture_runtime::blob::{Blob, BlobError};
-use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::controller::{BlobController, ControllerEvent, Lookahead};
 use gesture_runtime::device::{Device, DeviceError, DeviceEvent};
 use gesture_runtime::policy::Choice;
 use gesture_runtime::prosody::arith::{Arith, DefaultArith};
@@ -54,6 +59,19 @@ pub const CHUNK: usize = 256;
 /// Semantic labels given to a blob that has labels: `(sample, label)`, at DMA buffer
 /// boundaries (1.504 s and 4.0 s); `check` gives `gesture-sim run` the same as `--labels`.
 pub const LABELS: [(usize, usize); 2] = [(94 * CHUNK, 0), (250 * CHUNK, 0)];
+/// The look-ahead of an input named `*-ahead` (ms): the controller hears it this long before
+/// it is played; other inputs run live.
+pub const LOOKAHEAD_MS: u32 = 500;
+
+/// The look-ahead of input `name` ([`LOOKAHEAD_MS`] for a name ending in `-ahead`, else 0).
+pub fn lookahead_ms(name: &str) -> u32 {
+    if name.ends_with("-ahead") {
+        LOOKAHEAD_MS
+    } else {
+        0
+    }
+}
+
 /// Sample rate of the embedded audio.
 pub const AUDIO_RATE_HZ: u32 = 16_000;
 /// Servo channels of the board (the puppet rig, `rigs/puppet-8ch.toml`).
@@ -273,11 +291,16 @@ pub fn run_with<A: Arith>(
             .set_style(&w[..tones])
             .map_err(|_| RunError::Style)?;
     }
+    controller.set_lookahead(Lookahead::ms(lookahead_ms(name)));
     let mut device: BoardDevice<'_, '_, A> =
         Device::new(controller, [RecordingPin::default(); CHANNELS]).map_err(RunError::Device)?;
     probe.ready();
 
-    writeln!(out, "input {name} samples={}", audio.len() / 2).map_err(|_| RunError::Output)?;
+    // (`{}` of a `str` would link the padding code into the firmware.)
+    out.write_str("input ")
+        .and_then(|()| out.write_str(name))
+        .and_then(|()| writeln!(out, " samples={}", audio.len() / 2))
+        .map_err(|_| RunError::Output)?;
     let mut sum = Summary {
         belief_hash: FNV_OFFSET,
         pose_hash: FNV_OFFSET,
@@ -288,8 +311,13 @@ pub fn run_with<A: Arith>(
     // The DMA buffer: samples land here in RAM before the controller sees them.
     let mut dma = [0i16; CHUNK];
     let labelled = blob.labels() > 0;
-    for (k, bytes) in audio.chunks(2 * CHUNK).enumerate() {
-        let n = bytes.len() / 2;
+    // A look-ahead input is followed by that much silence (after a recording, nothing), so
+    // every tick of the audio is played.
+    let ahead = lookahead_ms(name);
+    let heard = audio.len() / 2 + (ahead as usize * AUDIO_RATE_HZ as usize).div_ceil(1000);
+    for k in 0..heard.div_ceil(CHUNK) {
+        let n = CHUNK.min(heard - k * CHUNK);
+        let bytes = audio.get(2 * k * CHUNK..).unwrap_or(&[]);
         if labelled {
             for &(at, label) in &LABELS {
                 if at == k * CHUNK {
@@ -298,7 +326,8 @@ pub fn run_with<A: Arith>(
                 }
             }
         }
-        for (s, b) in dma.iter_mut().zip(bytes.chunks_exact(2)) {
+        dma.fill(0);
+        for (s, b) in dma[..n].iter_mut().zip(bytes.chunks_exact(2)) {
             *s = i16::from_le_bytes([b[0], b[1]]);
         }
         probe.chunk_begin();

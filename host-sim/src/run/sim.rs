@@ -324,10 +324,20 @@ pub fn simulate(
             record(&mut sim, blob, channels, now_s, false, style, e)
         });
     }
+    // With look-ahead, the recording is followed by that much silence (nothing more is heard),
+    // so every tick of the audio is played.
+    let pad = (opts.lookahead.ms as usize * rate as usize).div_ceil(1000);
+    if pad > 0 {
+        let silence = vec![0i16; pad];
+        let now_s = pushed as f64 / rate as f64;
+        for chunk in silence.chunks(opts.chunk.max(1)) {
+            let _ = device.push(chunk, &mut |e| {
+                record(&mut sim, blob, channels, now_s, false, style, e)
+            });
+        }
+    }
     let now_s = pushed as f64 / rate as f64;
     let _ = device.finish(&mut |e| record(&mut sim, blob, channels, now_s, true, style, e));
-    // With look-ahead, the end of the recording is played after it was heard.
-    let _ = device.drain(&mut |e| record(&mut sim, blob, channels, now_s, true, style, e));
     if sim.styles.is_empty() {
         sim.styles.push(StyleChange {
             time_s: 0.0,

@@ -283,7 +283,9 @@ impl Ahead {
             return self.rate;
         }
         let want = self.wanted_rate(lib, player, now);
-        self.rate = want.clamp(self.rate - self.slew, self.rate + self.slew);
+        // (max and min, not clamp: clamp with bounds not known at build time links float
+        // formatting for its panic message, kilobytes on a board.)
+        self.rate = want.max(self.rate - self.slew).min(self.rate + self.slew);
         self.rate
     }
 
