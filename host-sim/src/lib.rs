@@ -15,7 +15,8 @@
 //! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
 //! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
 //! - [`run`](mod@run): `gesture-sim run`: a WAV file through the runtime's device loop, with
-//!   BVH, timeline, servo trace and previews written to a folder.
+//!   BVH, timeline, servo trace and previews written to a folder; with `--show`, its show
+//!   file, which `gesture-sim play-show` plays with no inference ([`run::show`]).
 //! - [`metrics_cmd`]: `gesture-sim metrics`: the motion-quality figures of a `run` folder.
 //! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
 //!   [`live::AudioSource`] trait, with a fake source for tests.
