@@ -259,3 +259,16 @@ fn a_show_is_refused_by_another_blob_or_library() {
     );
     assert!(ShowPlayer::from_blob(&Show::parse(&frame).unwrap(), &blob).is_err());
 }
+
+/// The `show` fuzz target starts from the documented example (`tests/fuzz/seeds/show`).
+#[test]
+fn the_show_fuzz_seed_is_the_documented_example() {
+    let seed = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fuzz/seeds/show/golden.show");
+    assert_eq!(
+        hex(&std::fs::read(&seed).unwrap()),
+        hex(&documented_bytes()),
+        "{} is out of date: write the bytes of docs/show-format.md, section 6, to it",
+        seed.display()
+    );
+}
