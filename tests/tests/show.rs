@@ -113,7 +113,7 @@ fn a_baked_show_of_synthetic_speech_replays_the_controller_bit_for_bit() {
         take_seconds: 30.0,
     };
     write_corpus(&p, &held, |_, _| {}).unwrap();
-    let pcm = load_wav_at(&held.join("take_000.wav"), rate).unwrap();
+    let pcm = load_wav_at(held.join("take_000.wav"), rate).unwrap();
     let commands = bake_and_replay(&blob, &pcm.samples);
     eprintln!("synthetic: {commands} commands replayed");
     assert!(commands > 10, "{commands} commands");
@@ -128,7 +128,7 @@ fn a_baked_show_of_real_speech_replays_the_controller_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let blob = synthetic_blob(dir.path());
     let rate = Blob::parse(&blob).unwrap().prosody_config().sample_rate_hz;
-    let pcm = load_wav_at(&scott.join("2_scott_0_1_1.wav"), rate).unwrap();
+    let pcm = load_wav_at(scott.join("2_scott_0_1_1.wav"), rate).unwrap();
     let commands = bake_and_replay(&blob, &pcm.samples);
     eprintln!("beat-scott: {commands} commands replayed");
     assert!(commands > 10, "{commands} commands");

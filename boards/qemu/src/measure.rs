@@ -225,7 +225,8 @@ impl Probe for Timing<'_> {
             }
             ControllerEvent::Pose { .. }
             | ControllerEvent::Onset(_)
-            | ControllerEvent::Label { .. } => {}
+            | ControllerEvent::Label { .. }
+            | ControllerEvent::Play { .. } => {}
         }
         self.last_event = t;
     }

@@ -36,13 +36,28 @@ pub fn write_show(path: &Path, sim: &Simulation, blob: &Blob<'_>) -> Result<Stri
         source: e.source,
     })?;
     Ok(format!(
-        "show {}: {} ticks, {} commands, {} bytes, for the blob with CRC {:08x}",
+        "show {}: {} ticks, {} commands, {} bytes, for the blob with CRC {:08x} \
+         (pose_hash={:08x})",
         path.display(),
         sim.poses.len(),
         Show::parse(&bytes).map_or(0, |s| s.header().commands),
         bytes.len(),
-        blob.header().crc
+        blob.header().crc,
+        pose_hash(&sim.poses)
     ))
+}
+
+/// FNV-1a over the bits of every pose value, in order (the hash of the QEMU firmware's trace,
+/// `boards/qemu/src/drive.rs`, which its `check` compares with a show played on the device).
+pub fn pose_hash(poses: &[Vec<f32>]) -> u32 {
+    let mut h = 0x811c_9dc5u32;
+    for v in poses.iter().flatten() {
+        for b in v.to_bits().to_le_bytes() {
+            h ^= b as u32;
+            h = h.wrapping_mul(0x0100_0193);
+        }
+    }
+    h
 }
 
 /// What `play-show` was asked to do.
