@@ -326,8 +326,8 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             show,
             audio,
             out: dir,
-        } => run_cmd::show::play_show(
-            &run_cmd::show::PlayShowConfig {
+        } => crate::play_show::play_show(
+            &crate::play_show::PlayShowConfig {
                 blob: blob.clone(),
                 show: show.clone(),
                 audio: audio.clone(),

@@ -63,11 +63,11 @@ pub enum SimError {
     Ros2(#[from] crate::ros2::Ros2Error),
     /// `play-show` failed (boxed: run errors are large).
     #[error(transparent)]
-    PlayShow(Box<crate::run::show::PlayShowError>),
+    PlayShow(Box<crate::play_show::PlayShowError>),
 }
 
-impl From<crate::run::show::PlayShowError> for SimError {
-    fn from(e: crate::run::show::PlayShowError) -> Self {
+impl From<crate::play_show::PlayShowError> for SimError {
+    fn from(e: crate::play_show::PlayShowError) -> Self {
         Self::PlayShow(Box::new(e))
     }
 }

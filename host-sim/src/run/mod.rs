@@ -602,7 +602,14 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
         written.push(path.to_path_buf());
     }
     let show_line = match &cfg.show {
-        Some(path) => Some(show::write_show(path, &sim, &blob)?),
+        Some(path) => {
+            Some(
+                show::write_show(path, &sim, &blob).map_err(|reason| RunError::Render {
+                    what: "the show file",
+                    reason,
+                })?,
+            )
+        }
         None => None,
     };
     if let Some(p) = &publisher {
