@@ -15,7 +15,7 @@
 //! the kind's fixed arguments; postcard would give the same bytes for the records only
 //! through a hand-written serializer, and its zero-copy reading of a borrowed sequence of
 //! enums needs a decoder per record anyway. The reader is about as small as the blob's
-//! header check (a firmware that only plays shows links no postcard).
+//! header check.
 //!
 //! **Check once, then trust.** [`Show::parse`] checks every rule of the format (header, CRC,
 //! every record; typed [`ShowError`], never a panic on any bytes) and
@@ -30,9 +30,12 @@
 //! samples have arrived), applies the commands stamped for a tick before that tick's frame
 //! (a `Hold` makes the tick show its frame again) and clamps every pose to the rig's limits
 //! as the controller does. The poses are the controller's, whatever the chunking. After the
-//! last tick it reports nothing more and [`ShowPlayer::pose`] holds the last pose.
+//! last tick it reports nothing more and [`ShowPlayer::pose`] holds the last pose. The clock
+//! is the played audio's: a controller with look-ahead
+//! ([`Controller::set_lookahead`](crate::controller::Controller::set_lookahead)) plays tick
+//! `k` once it has been fed the lead beyond those samples, that is when they are played.
 //!
-//! Memory: a [`ShowPlayer`] is a player and one pose (about 6 KiB with 256 channels); the
+//! Memory: a [`ShowPlayer`] is a player and one pose (5 248 bytes on a Cortex-M4F); the
 //! show stays where its bytes are (flash). Nothing here allocates but the writer
 //! ([`encode`], feature `encode`).
 //!
