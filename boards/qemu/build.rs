@@ -24,7 +24,11 @@ fn main() {
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=mps2-an386.x");
     println!("cargo:rerun-if-changed=mps2-an505.x");
-    for asset in ["policy.blob", "speech.raw", "stress.raw"] {
+    let show = env::var_os("CARGO_FEATURE_SHOW").map(|_| "speech.show");
+    for asset in ["policy.blob", "speech.raw", "stress.raw"]
+        .into_iter()
+        .chain(show)
+    {
         let path = PathBuf::from("assets").join(asset);
         println!("cargo:rerun-if-changed={}", path.display());
         if !path.is_file() {

@@ -132,6 +132,26 @@ pub enum Command {
         /// key phrase heard brings its label.
         #[arg(long, value_name = "FILE")]
         keywords: Option<PathBuf>,
+        /// Also write the run's show file (its player commands, for `play-show` and show
+        /// boards; docs/show-format.md).
+        #[arg(long, value_name = "FILE")]
+        show: Option<PathBuf>,
+    },
+    /// Play a show file (from `run --show`) with the runtime's ShowPlayer, no inference, and
+    /// write servo.csv and motion.bvh into a folder.
+    PlayShow {
+        /// The policy blob the show was baked against.
+        #[arg(long, value_name = "BLOB")]
+        blob: PathBuf,
+        /// The show file.
+        #[arg(long, value_name = "FILE")]
+        show: PathBuf,
+        /// Audio whose length sets the sample clock [default: just enough for every tick].
+        #[arg(long, value_name = "WAV")]
+        audio: Option<PathBuf>,
+        /// Output folder (created if needed).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
     },
     /// Keyword spotting alone (feature `kws`): the key phrases PocketSphinx hears in a WAV
     /// file, as CSV `time_s,phrase,label` (time: when detected).
@@ -284,6 +304,7 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
             style,
             labels,
             keywords,
+            show,
         } => run_cmd::run(
             &RunConfig {
                 blob: blob.clone(),
@@ -303,6 +324,22 @@ pub fn execute(cli: &Cli, out: &mut impl Write) -> Result<(), SimError> {
                 style: style.clone(),
                 labels: labels.clone(),
                 keywords: keywords.clone(),
+                show: show.clone(),
+            },
+            out,
+        )
+        .map_err(SimError::from),
+        Command::PlayShow {
+            blob,
+            show,
+            audio,
+            out: dir,
+        } => crate::play_show::play_show(
+            &crate::play_show::PlayShowConfig {
+                blob: blob.clone(),
+                show: show.clone(),
+                audio: audio.clone(),
+                out: dir.clone(),
             },
             out,
         )

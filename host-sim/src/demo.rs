@@ -399,6 +399,7 @@ fn simulate(
         video,
         vmc: None,
         bone_map: None,
+        show: None,
         blender: false,
         ros2: false,
         ros2_topic: None,

@@ -61,6 +61,15 @@ pub enum SimError {
     /// `--ros2`, `--mcap` or the URDF could not start, be made or be sent.
     #[error(transparent)]
     Ros2(#[from] crate::ros2::Ros2Error),
+    /// `play-show` failed (boxed: run errors are large).
+    #[error(transparent)]
+    PlayShow(Box<crate::play_show::PlayShowError>),
+}
+
+impl From<crate::play_show::PlayShowError> for SimError {
+    fn from(e: crate::play_show::PlayShowError) -> Self {
+        Self::PlayShow(Box::new(e))
+    }
 }
 
 impl From<RunError> for SimError {
@@ -76,6 +85,7 @@ impl SimError {
             Self::Audio(_) | Self::Read { .. } | Self::Data { .. } => 2,
             Self::Config(_) | Self::Output(_) => 1,
             Self::Run(e) => e.exit_code(),
+            Self::PlayShow(e) => e.exit_code(),
             Self::Live(e) => e.exit_code(),
             Self::Demo(e) => e.exit_code(),
             Self::Metrics(_) => 2,

@@ -15,7 +15,10 @@
 //! - [`eval_cmd`]: `gesture-sim eval-prosody`: the comparison over the shared recordings.
 //! - [`bench`](mod@bench): `gesture-sim bench-prosody`: front-end speed.
 //! - [`run`](mod@run): `gesture-sim run`: a WAV file through the runtime's device loop, with
-//!   BVH, timeline, servo trace and previews written to a folder.
+//!   BVH, timeline, servo trace and previews written to a folder; with `--show`, its show
+//!   file ([`run::show`]).
+//! - [`play_show`]: `gesture-sim play-show`: a show file played with the runtime's
+//!   `ShowPlayer` (no inference), `servo.csv` and `motion.bvh` as a run writes them.
 //! - [`metrics_cmd`]: `gesture-sim metrics`: the motion-quality figures of a `run` folder.
 //! - [`live`]: `gesture-sim live` and `devices`: the microphone (cpal) behind the
 //!   [`live::AudioSource`] trait, with a fake source for tests.
@@ -46,6 +49,7 @@ pub mod kws;
 pub mod labels;
 pub mod live;
 pub mod metrics_cmd;
+pub mod play_show;
 pub mod prosody_cmd;
 pub mod ros2;
 pub mod run;

@@ -38,6 +38,8 @@
 //! - [`player`]: segment playback as rig poses with a short blend at cuts.
 //! - [`controller`]: samples in, poses out: front-end, belief, decisions and playback on one
 //!   sample clock; built from a validated blob.
+//! - [`show`]: show files: a run's player commands baked against its blob, validated once,
+//!   played back by a bare player with the controller's poses and no inference.
 //! - [`device`]: the one device loop: a blob's controller and its servo rig, samples in, poses,
 //!   duty cycles and events out; what boards, the simulator and evaluations run.
 //! - [`rig`]: servo calibration and the `ServoRig`: pose angles to clamped, slew-limited PWM
@@ -65,3 +67,4 @@ pub mod policy;
 pub mod prosody;
 pub mod rig;
 pub mod rotation;
+pub mod show;

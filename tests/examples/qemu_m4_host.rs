@@ -15,11 +15,16 @@
 //! - `sim-decisions --timeline timeline.json` prints the decisions of a `gesture-sim run`
 //!   (its `timeline.json`) as the trace's `decision` lines, for the same comparison against the
 //!   simulator itself.
+//! - `show --blob BLOB --show SHOW --input FILE` prints the line the firmware's `show` build
+//!   must print: the show played by the runtime's `ShowPlayer` over `FILE`'s sample count
+//!   (`boards/qemu/src/show.rs`, included below).
 //!
 //! Exit status: 0 on success, 1 on any error (one line on stderr naming the file).
 
 #[path = "../../boards/qemu/src/drive.rs"]
 mod drive;
+#[path = "../../boards/qemu/src/show.rs"]
+mod show;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -68,6 +73,18 @@ enum Command {
         /// Run the fixed-point front-end (the ARMv6-M firmware's) instead of the f32 one.
         #[arg(long)]
         fixed: bool,
+    },
+    /// Print the line the firmware's `show` build must print.
+    Show {
+        /// The policy blob.
+        #[arg(long)]
+        blob: PathBuf,
+        /// The show file (`gesture-sim run --show`).
+        #[arg(long)]
+        show: PathBuf,
+        /// The input (raw i16 LE, 16 kHz) whose sample count the clock counts.
+        #[arg(long)]
+        input: PathBuf,
     },
 }
 
@@ -189,6 +206,22 @@ fn trace(blob: &Path, inputs: &[String], fixed: bool) -> Result<(), String> {
     Ok(())
 }
 
+fn play_show(blob: &Path, show: &Path, input: &Path) -> Result<(), String> {
+    let samples = read(input)?.len() / 2;
+    let mut text = String::new();
+    let result = show::run(&read(blob)?, &read(show)?, samples, &mut text);
+    print!("{text}");
+    result.map(|_| ()).map_err(|e| {
+        format!(
+            "{} with {}: {:?} ({})",
+            show.display(),
+            blob.display(),
+            e,
+            e.name()
+        )
+    })
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -199,6 +232,7 @@ fn main() -> ExitCode {
             inputs,
             fixed,
         } => trace(blob, inputs, *fixed),
+        Command::Show { blob, show, input } => play_show(blob, show, input),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

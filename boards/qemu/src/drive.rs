@@ -217,9 +217,12 @@ impl SetDutyCycle for RecordingPin {
     }
 }
 
-const FNV_OFFSET: u32 = 0x811c_9dc5;
+/// FNV-1a's offset basis: the hash of nothing.
+pub const FNV_OFFSET: u32 = 0x811c_9dc5;
 
-fn fnv(mut h: u32, values: &[f32]) -> u32 {
+/// FNV-1a of `values`' `f32` bit patterns (little-endian), continuing from `h` (`show.rs`
+/// hashes a show's poses with it too).
+pub fn fnv(mut h: u32, values: &[f32]) -> u32 {
     for v in values {
         for b in v.to_bits().to_le_bytes() {
             h ^= b as u32;

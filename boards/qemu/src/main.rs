@@ -15,12 +15,22 @@
 //!
 //! With the `measure` feature it also times the controller with SysTick under
 //! `qemu -icount shift=0` and prints `measure` lines for `report` ([`measure`]).
+//!
+//! With the `show` feature it is a show board instead: no controller runs; it plays the show
+//! `make-assets` baked from the speech input (`assets/speech.show`, `gesture-sim run --show`)
+//! with the runtime's `ShowPlayer` over the speech input's sample count ([`show`]), prints
+//! `show ticks=N pose_hash=H` and the same `memory` line, and exits (a separate QEMU run in
+//! `check`: the player does not fit beside the controller in the M4's code budget).
 #![no_std]
 #![no_main]
+// The `show` build keeps the controller's loop compiled but never calls it.
+#![cfg_attr(feature = "show", allow(dead_code))]
 
 mod drive;
 #[cfg(feature = "measure")]
 mod measure;
+#[cfg(feature = "show")]
+mod show;
 
 use core::fmt::{self, Write};
 
@@ -43,6 +53,10 @@ static INPUTS: [(&str, &[u8]); 3] = [
         include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/stress.raw")),
     ),
 ];
+
+/// The show baked from the speech input (`assets/speech.show`; the `show` build).
+#[cfg(feature = "show")]
+static SHOW: &[u8] = include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/speech.show"));
 
 /// Semihosting output in whole lines: one `SYS_WRITE` per line instead of one per fragment.
 struct HostLines {
@@ -151,6 +165,31 @@ impl drive::Probe for StackProbe {
     }
 }
 
+/// The show board: plays [`SHOW`] over the speech input's samples ([`show::run`]).
+#[cfg(feature = "show")]
+#[entry]
+fn main() -> ! {
+    let mut out = HostLines::new(hio::hstdout());
+    let mut err = HostLines::new(hio::hstderr());
+    let samples = INPUTS[0].1.len() / 2;
+    let result = show::run(BLOB, SHOW, samples, &mut out);
+    if let Err(e) = &result {
+        let _ = writeln!(err, "error: show: {}", e.name());
+    }
+    let _ = writeln!(
+        err,
+        "memory peak_stack_bytes={} show_player_bytes={} show_bytes={} blob_bytes={}",
+        peak_stack_bytes(),
+        core::mem::size_of::<
+            gesture_runtime::show::ShowPlayer<'static, gesture_runtime::blob::Blob<'static>>,
+        >(),
+        SHOW.len(),
+        BLOB.len()
+    );
+    exit(result.is_ok())
+}
+
+#[cfg(not(feature = "show"))]
 #[entry]
 fn main() -> ! {
     let mut out = HostLines::new(hio::hstdout());

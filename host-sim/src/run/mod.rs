@@ -25,6 +25,8 @@
 //! - with `--vmc HOST:PORT`, the poses streamed to an avatar app ([`crate::vmc`]);
 //! - with `--ros2` (feature `ros2`) or `--mcap FILE`, the joint states as
 //!   `sensor_msgs/JointState` over DDS or in an MCAP file, and `robot.urdf` ([`crate::ros2`]).
+//! - with `--show FILE`, the run's show file (its player commands; `gesture-sim play-show`
+//!   plays it with no inference: [`show`]).
 //!
 //! The summary on stdout gives the files, the audio duration, the decisions, the median and
 //! maximum syllable detection latency and the simulation speed as a multiple of real time
@@ -35,6 +37,7 @@ pub mod body;
 mod canvas;
 pub mod preview;
 pub mod servos;
+pub mod show;
 pub mod sim;
 pub mod timeline;
 pub mod video;
@@ -93,6 +96,8 @@ pub struct RunConfig {
     pub labels: Option<PathBuf>,
     /// Keyword spotting (`--keywords FILE`; [`crate::kws`]).
     pub keywords: Option<PathBuf>,
+    /// Also write the run's show file here (`--show FILE`; [`show`]).
+    pub show: Option<PathBuf>,
 }
 
 /// Why `run` failed.
@@ -443,6 +448,7 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
         check_mcap_path(m)?;
         outputs.push(m.clone());
     }
+    outputs.extend(cfg.show.clone());
     let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
     let mut inputs: Vec<&Path> = vec![&cfg.blob, &cfg.audio];
     inputs.extend(cfg.rig.as_deref());
@@ -599,6 +605,17 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
         })?;
         written.push(path.to_path_buf());
     }
+    let show_line = match &cfg.show {
+        Some(path) => {
+            Some(
+                show::write_show(path, &sim, &blob).map_err(|reason| RunError::Render {
+                    what: "the show file",
+                    reason,
+                })?,
+            )
+        }
+        None => None,
+    };
     if let Some(p) = &publisher {
         writeln!(
             out,
@@ -631,6 +648,9 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
         &written,
         total.elapsed().as_secs_f64(),
     )?;
+    if let Some(line) = show_line {
+        writeln!(out, "{line}")?;
+    }
     Ok(())
 }
 
