@@ -156,6 +156,8 @@ pub struct Controller<
     rest: RestSet,
     /// Length of a pause step (ms).
     pause_ms: u32,
+    /// The segment and frame shown at the last tick.
+    last_shown: (usize, usize),
     /// Audio heard before it is played (see [`Lookahead`]).
     ahead: Ahead,
 }
@@ -204,6 +206,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             rest: RestSet::EMPTY,
             pause_ms: config.syllables.pause_frames.saturating_mul(10),
             ahead: Ahead::new(),
+            last_shown: (0, 0),
         });
         if let Err(e) = me.front_end.configure(config) {
             *slot = None;
@@ -413,6 +416,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         }
         let tick = self.ticks;
         self.ticks += 1;
+        let last_shown = core::mem::replace(&mut self.last_shown, (segment, played));
         if self.ticks == 1 {
             self.history.write(Visit {
                 segment: segment.min(u16::MAX as usize) as u16,
@@ -443,7 +447,16 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         if let Some(d) = self.deferred {
             let pause = match d.at {
                 Some((s, f)) if s == segment => played >= f,
-                _ => self.hands_pause(segment, played),
+                // Faster playback may pass a frame by: any pause since the last tick counts.
+                _ => {
+                    let (s, f) = last_shown;
+                    let from = if s == segment && f < played {
+                        f + 1
+                    } else {
+                        played
+                    };
+                    (from..=played).any(|g| self.hands_pause(segment, g))
+                }
             };
             if pause {
                 self.deferred = None;

@@ -90,7 +90,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     /// "Semantic labels"): from the next exit point on, the controller prefers the segments
     /// carrying it and may enter one just before its stroke; the label is served once that
     /// stroke plays, or dropped after the blob's timeout. A label that arrives while another
-    /// is served waits (at most [`LABEL_QUEUE`]). Reports `Received` through the next call's
+    /// is served waits (at most [`LABEL_QUEUE`](super::LABEL_QUEUE)). Reports `Received` through the next call's
     /// events.
     pub fn push_label(&mut self, label: usize) -> Result<(), LabelError> {
         self.labels.push(label, self.tables.labels(), self.ticks)
