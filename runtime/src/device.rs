@@ -182,18 +182,6 @@ impl<'c, 'a, P: SetDutyCycle, const N: usize, A: Arith> Device<'c, 'a, P, N, A> 
         result
     }
 
-    /// Plays the ticks look-ahead still holds back for the audio heard
-    /// ([`Controller::drain`](crate::controller::Controller::drain)), at the end of a known
-    /// recording.
-    pub fn drain(&mut self, sink: &mut impl FnMut(DeviceEvent<'_, P, N>)) -> Result<(), P::Error> {
-        let (controller, rig, dt) = (&mut *self.controller, &mut self.rig, self.dt_s);
-        let mut result = Ok(());
-        controller.drain(&mut |ev| {
-            Self::route(rig, dt, &mut result, sink, ev);
-        });
-        result
-    }
-
     fn route(
         rig: &mut ServoRig<P, N>,
         dt: f32,

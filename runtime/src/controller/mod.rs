@@ -71,7 +71,7 @@ use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
 use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
-use crate::player::{LibraryFrames, Player, PlayerCommand, MAX_CHANNELS};
+use crate::player::{within_limits, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS};
 use crate::policy::{
     select_labelled, select_styled, Choice, History, Penalties, PolicyTables, Style, Variety, Visit,
 };
@@ -402,18 +402,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             });
         }
         let played = self.player.tick_advancing(self.lib, &mut self.pose, !hold);
-        // What leaves the controller is within the rig's limits and finite, whatever the
-        // frames and the blend made of it (a board without the rig's own clamp must not drive
-        // a servo into its stop).
-        let channels = self.lib.channels().min(MAX_CHANNELS);
-        for (ch, v) in self.pose[..channels].iter_mut().enumerate() {
-            let (lo, hi, neutral) = self.lib.limits(ch);
-            *v = if v.is_finite() {
-                v.max(lo).min(hi)
-            } else {
-                neutral
-            };
-        }
+        // What leaves the controller is within the rig's limits and finite.
+        within_limits(self.lib, &mut self.pose);
         let tick = self.ticks;
         self.ticks += 1;
         let last_shown = core::mem::replace(&mut self.last_shown, (segment, played));

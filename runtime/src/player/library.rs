@@ -52,6 +52,23 @@ pub fn library_speed_cap<L: LibraryFrames + ?Sized>(lib: &L) -> f32 {
     top
 }
 
+/// Puts every channel of `pose` within its calibrated limits (a non-finite value becomes the
+/// neutral angle), as the controller and a show's player do with every pose before it leaves
+/// them, whatever the frames and the blends made of it (a board without the rig's own clamp
+/// must not drive a servo into its stop); returns the channels of the pose.
+pub fn within_limits<L: LibraryFrames + ?Sized>(lib: &L, pose: &mut [f32; MAX_CHANNELS]) -> usize {
+    let channels = lib.channels().min(MAX_CHANNELS);
+    for (ch, v) in pose[..channels].iter_mut().enumerate() {
+        let (lo, hi, neutral) = lib.limits(ch);
+        *v = if v.is_finite() {
+            v.max(lo).min(hi)
+        } else {
+            neutral
+        };
+    }
+    channels
+}
+
 /// The library's frames as the player needs them. Built only from validated data: indices
 /// passed in are always in range.
 pub trait LibraryFrames {

@@ -47,7 +47,7 @@
 
 mod library;
 
-pub use library::{library_speed_cap, LibraryFrames};
+pub use library::{library_speed_cap, within_limits, LibraryFrames};
 
 use crate::rotation::{
     euler_angles, euler_matrix, quat_conj, quat_exp, quat_log, quat_matrix, quat_mul, quaternion,

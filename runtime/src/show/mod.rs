@@ -37,7 +37,7 @@
 //!
 //! Memory: a [`ShowPlayer`] is a player and one pose (5 248 bytes on a Cortex-M4F); the
 //! show stays where its bytes are (flash). Nothing here allocates but the writer
-//! ([`encode`], feature `encode`).
+//! (the `encode` module, feature `encode`).
 //!
 //! Files: `format` (the constants, [`SHOW_MAGIC`] and the rest), `error` ([`ShowError`]), `parse` ([`Show`],
 //! [`Commands`]), `player` ([`ShowPlayer`]), `encode` (the writer).

@@ -4,7 +4,9 @@
 use super::error::ShowError;
 use super::parse::{Commands, Show};
 use crate::blob::Blob;
-use crate::player::{library_speed_cap, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS};
+use crate::player::{
+    library_speed_cap, within_limits, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
+};
 
 /// One tick of a show: its pose and what it showed.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -120,15 +122,7 @@ impl<'a, L: LibraryFrames + ?Sized> ShowPlayer<'a, L> {
         let frame = self
             .player
             .tick_advancing(self.lib, &mut self.pose, advance);
-        let channels = self.lib.channels().min(MAX_CHANNELS);
-        for (ch, v) in self.pose[..channels].iter_mut().enumerate() {
-            let (lo, hi, neutral) = self.lib.limits(ch);
-            *v = if v.is_finite() {
-                v.max(lo).min(hi)
-            } else {
-                neutral
-            };
-        }
+        let channels = within_limits(self.lib, &mut self.pose);
         let tick = self.tick;
         self.tick += 1;
         sink(ShowTick {
