@@ -13,7 +13,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::rig::{ChannelCal, ServoRig, MAX_CHANNELS};
+use gesture_runtime::rig::{ChannelCal, MAX_CHANNELS};
 use gesture_runtime::show::{Show, ShowError, ShowPlayer};
 use gesture_trainer::audio::load_wav_at;
 use gesture_trainer::motion::write_bvh;
@@ -21,7 +21,6 @@ use gesture_trainer::rig::PoseSkeleton;
 
 use crate::run::sim::Simulation;
 use crate::run::{read_blob, servo_csv, write_all, RunError};
-use crate::servo::VirtualPin;
 
 /// What `play-show` was asked to do.
 #[derive(Clone, Debug)]
@@ -160,45 +159,10 @@ fn play(
     samples: u64,
     rate: u32,
 ) -> Result<Simulation, RunError> {
-    let channels = blob.channels();
     let mut cals = [ChannelCal::HOBBY; MAX_CHANNELS];
-    for (ch, c) in cals.iter_mut().enumerate().take(channels) {
+    for (ch, c) in cals.iter_mut().enumerate().take(blob.channels()) {
         *c = blob.calibration(ch).unwrap_or(ChannelCal::HOBBY);
     }
-    let mut rig = ServoRig::new(
-        [VirtualPin::default(); MAX_CHANNELS],
-        cals,
-        blob.period_us(),
-    )
-    .map_err(|e| RunError::Sim(e.to_string()))?;
-    let _ = rig.neutral();
-    let dt = 1.0 / blob.fps();
-    let mut sim = Simulation {
-        sample_rate_hz: rate,
-        fps: blob.fps() as f64,
-        duration_s: samples as f64 / rate as f64,
-        ..Simulation::default()
-    };
-    let chunk = (rate as u64 / 100).max(1);
-    let mut fed = 0u64;
-    let mut sink = |t: gesture_runtime::show::ShowTick<'_>| {
-        // Virtual pins cannot fail.
-        let _ = rig.apply(t.pose, dt);
-        sim.poses.push(t.pose.to_vec());
-        sim.shown.push((t.segment, t.frame));
-        sim.duties.push(
-            rig.pins()[..channels]
-                .iter()
-                .map(VirtualPin::duty)
-                .collect(),
-        );
-        sim.angles.push(rig.angles()[..channels].to_vec());
-    };
-    player.push(0, &mut sink);
-    while fed < samples {
-        let n = chunk.min(samples - fed);
-        fed += n;
-        player.push(n as usize, &mut sink);
-    }
-    Ok(sim)
+    crate::run::bake::play_on(player, blob, samples, rate, &cals, blob.period_us())
+        .map_err(RunError::Sim)
 }

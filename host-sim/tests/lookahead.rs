@@ -114,3 +114,56 @@ fn run_takes_a_look_ahead_and_refuses_a_bad_one() {
     }
     assert!(ticks.iter().all(|&t| t == ticks[0]), "{ticks:?}");
 }
+
+/// `--lookahead-ms all` plans the whole file and plays it from its show: the show it writes,
+/// played by `play-show` with the same audio, gives the run's servo trace and motion byte for
+/// byte; a style or labels with `all` are one line and exit 2, nothing written.
+#[test]
+fn a_baked_run_is_its_show_and_refuses_a_style() {
+    let s = setup();
+    let dir = tempfile::tempdir().unwrap();
+    let run = dir.path().join("baked");
+    let show = dir.path().join("baked.show");
+    let o = run_into(
+        &s.full,
+        &s.wav,
+        &run,
+        &[
+            "--lookahead-ms",
+            "all",
+            "--no-video",
+            "--show",
+            show.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let played = dir.path().join("played");
+    let o = sim(&[
+        "play-show",
+        "--blob",
+        s.full.to_str().unwrap(),
+        "--show",
+        show.to_str().unwrap(),
+        "--audio",
+        s.wav.to_str().unwrap(),
+        "--out",
+        played.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    for f in ["servo.csv", "motion.bvh"] {
+        let (a, b) = (
+            std::fs::read(run.join(f)).unwrap(),
+            std::fs::read(played.join(f)).unwrap(),
+        );
+        assert!(a == b, "{f} differs between the baked run and its show");
+    }
+    let styled = styled_blob();
+    let out = dir.path().join("styled");
+    let o = run_into(
+        &styled,
+        &s.wav,
+        &out,
+        &["--lookahead-ms", "all", "--no-video", "--energy", "0.5"],
+    );
+    refused(&o, &out, "neutral style");
+}

@@ -37,6 +37,7 @@
 #![warn(missing_docs)]
 
 pub mod audio;
+pub mod bake;
 pub mod cli;
 pub mod control;
 pub mod corpus;

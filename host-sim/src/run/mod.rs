@@ -32,11 +32,13 @@
 //! maximum syllable detection latency and the simulation speed as a multiple of real time
 //! (simulation only, without rendering and writing).
 
+pub mod bake;
 pub mod blender;
 pub mod body;
 mod canvas;
 pub mod preview;
 pub mod servos;
+pub use servos::servo_csv;
 pub mod show;
 pub mod sim;
 pub mod timeline;
@@ -290,24 +292,6 @@ pub struct Outputs {
     pub ros_details: (String, String),
 }
 
-/// `servo.csv` of a run.
-pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
-    let mut s = String::from("tick,time_s");
-    for n in names {
-        s.push(',');
-        s.push_str(n);
-    }
-    s.push('\n');
-    for (tick, row) in sim.duties.iter().enumerate() {
-        s.push_str(&format!("{tick},{:.4}", tick as f64 / sim.fps));
-        for d in row {
-            s.push_str(&format!(",{d}"));
-        }
-        s.push('\n');
-    }
-    s
-}
-
 /// Every file a run may write into its folder.
 pub const OUTPUT_NAMES: [&str; 10] = [
     "motion.bvh",
@@ -465,6 +449,10 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
     let (cals, period_us) = calibrations(&blob, &cfg.blob, cfg.rig.as_deref())?;
     let tones: Vec<&str> = blob.tone_names().collect();
     let styles = cfg.style.schedule(&tones).map_err(RunError::Style)?;
+    if cfg.lookahead == Horizon::All {
+        bake::check_plannable(&styles, cfg.labels.is_some() || cfg.keywords.is_some())
+            .map_err(RunError::Style)?;
+    }
     let label_names: Vec<&str> = blob.label_names().collect();
     let mut labels = match &cfg.labels {
         Some(p) => crate::labels::read_label_track(p, &label_names).map_err(RunError::Style)?,
@@ -518,6 +506,11 @@ pub fn run(cfg: &RunConfig, out: &mut impl Write) -> Result<(), RunError> {
         &labels,
     )
     .map_err(RunError::Sim)?;
+    let sim = if cfg.lookahead == Horizon::All {
+        bake::baked(sim, &blob, &pcm.samples, &cals, period_us).map_err(RunError::Sim)?
+    } else {
+        sim
+    };
     let audio_name = cfg.audio.display().to_string();
     let blob_name = cfg.blob.display().to_string();
     let mut outputs = render(

@@ -12,7 +12,26 @@ use gesture_runtime::rig::ChannelCal;
 use serde::Serialize;
 
 use super::canvas::{Canvas, GRID, INK};
+use super::sim::Simulation;
 use crate::servo::MAX_DUTY;
+
+/// `servo.csv` of a run.
+pub fn servo_csv(sim: &Simulation, names: &[&str]) -> String {
+    let mut s = String::from("tick,time_s");
+    for n in names {
+        s.push(',');
+        s.push_str(n);
+    }
+    s.push('\n');
+    for (tick, row) in sim.duties.iter().enumerate() {
+        s.push_str(&format!("{tick},{:.4}", tick as f64 / sim.fps));
+        for d in row {
+            s.push_str(&format!(",{d}"));
+        }
+        s.push('\n');
+    }
+    s
+}
 
 /// The name of the rig `pack` makes without a rig file.
 pub const FULL_SKELETON: &str = "full-skeleton";

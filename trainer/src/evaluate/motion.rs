@@ -51,7 +51,9 @@ use serde::Serialize;
 
 use super::error::EvalError;
 use super::metrics::{measure, MotionMetrics, Speech};
-use super::playback::{play_ahead, play_delayed, play_schedule, shuffle_blocks, Playback};
+use super::playback::{
+    play_ahead, play_baked, play_delayed, play_schedule, shuffle_blocks, Playback,
+};
 use super::reference::{shown_speed_histogram, speech_matched_reference};
 use super::signals::speed_histogram;
 use super::trace::{entries_from_frames, Entry, Trace};
@@ -427,6 +429,14 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     }
     for &h in &e.lookahead {
         progress.set_message(format!("eval-motion: {}", h.row_name()));
+        if h == Horizon::All {
+            // The whole file planned: one run (the plan does not depend on the phase).
+            rows.push(Row::of_runs(
+                &h.row_name(),
+                &[measured(&play_baked(&blob, &samples, frames)?)?],
+            ));
+            continue;
+        }
         let mut ms = Vec::with_capacity(runs);
         for run in 0..runs {
             let p = play_ahead(&blob, &samples, rate, frames, run * step, h.lookahead())?;

@@ -101,6 +101,25 @@ pub(crate) fn play_ahead(
     Ok(p)
 }
 
+/// The whole of `samples` planned and played from its show ([`crate::bake`]), `frames` ticks.
+pub(crate) fn play_baked(
+    blob: &Blob<'_>,
+    samples: &[i16],
+    frames: usize,
+) -> Result<Playback, EvalError> {
+    let baked = crate::bake::bake(blob, samples).map_err(|e| EvalError::Device(e.to_string()))?;
+    let poses = baked
+        .play(blob)
+        .map_err(|e| EvalError::Device(e.to_string()))?;
+    let mut out = Playback::default();
+    for p in poses {
+        out.shown.push((p.segment, p.frame));
+        out.poses.push(p.pose);
+    }
+    hold_to(&mut out, frames);
+    Ok(out)
+}
+
 /// Truncates or extends (repeating the last tick) a playback to `frames` ticks.
 fn hold_to(p: &mut Playback, frames: usize) {
     p.poses.truncate(frames);

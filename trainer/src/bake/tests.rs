@@ -1,0 +1,165 @@
+//! The bake on a small synthetic corpus, and its bookkeeping on known answers.
+
+use super::*;
+use crate::corpus::{load_corpus, LoadOptions};
+use crate::inference::train::{fit, sequences, FitConfig};
+use crate::pack::{pack_model, PackOptions};
+use crate::synth::{write_corpus, SynthParams};
+
+/// A blob packed from a synthetic corpus, and the speech of its first take.
+fn blob_and_speech() -> (Vec<u8>, Vec<i16>) {
+    let dir = tempfile::tempdir().unwrap();
+    let params = SynthParams {
+        minutes: 1.0,
+        seed: 7,
+        take_seconds: 30.0,
+    };
+    write_corpus(&params, dir.path(), |_, _| {}).unwrap();
+    let c = load_corpus(&[dir.path().to_path_buf()], &LoadOptions::default()).unwrap();
+    let (seqs, segs) = sequences(&c, None);
+    let cfg = FitConfig {
+        states: Some(2),
+        clusters: Some(2),
+        restarts: 1,
+        l2: Some(1e-2),
+        ..FitConfig::default()
+    };
+    let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
+    let packed = pack_model(&model, &[dir.path().to_path_buf()], &PackOptions::default()).unwrap();
+    let mut wavs: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "wav"))
+        .collect();
+    wavs.sort();
+    let speech = crate::audio::load_wav_at(&wavs[0], model.sample_rate_hz)
+        .unwrap()
+        .samples;
+    (packed.bytes, speech)
+}
+
+/// Mean over the library strokes shown of the beat kernel (sigma 0.1 s) to the nearest onset.
+fn stroke_alignment(blob: &Blob<'_>, poses: &[BakedPose], onsets: &[f64], fps_milli: u64) -> f64 {
+    let sigma = 0.1 * fps_milli as f64 / 1000.0;
+    let mut v = Vec::new();
+    for (k, p) in poses.iter().enumerate() {
+        let prev = k.checked_sub(1).map(|j| (poses[j].segment, poses[j].frame));
+        if blob.is_peak(p.segment, p.frame) && prev != Some((p.segment, p.frame)) {
+            let d = onsets
+                .iter()
+                .map(|&o| (o - k as f64).abs())
+                .fold(f64::INFINITY, f64::min);
+            v.push((-0.5 * (d / sigma).powi(2)).exp());
+        }
+    }
+    assert!(v.len() >= 5, "too few strokes shown: {}", v.len());
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+/// Speech, then four seconds of silence, then speech: the baked body moves far less in the
+/// silence than in the speech; the run is as long as the audio and its show plays it.
+#[test]
+fn a_baked_run_rests_in_a_silence() {
+    let (bytes, speech) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let rate = blob.prosody_config().sample_rate_hz as usize;
+    let half = speech.len().min(12 * rate);
+    let mut audio = speech[..half].to_vec();
+    let silence_at = audio.len();
+    audio.resize(audio.len() + 4 * rate, 0);
+    audio.extend_from_slice(&speech[..half]);
+    let baked = bake(&blob, &audio).unwrap();
+    let fps_milli = (blob.fps() * 1000.0).round() as u64;
+    assert_eq!(baked.ticks, ticks_of(audio.len(), rate as u32, fps_milli));
+    assert!(baked.commands.windows(2).all(|w| w[0].0 <= w[1].0));
+    let poses = baked.play(&blob).unwrap();
+    assert_eq!(poses.len() as u64, baked.ticks);
+    let tick = |sample: usize| (sample as u64 * fps_milli / (rate as u64 * 1000)) as usize;
+    // Mean change of the pose per tick (degrees over channels) over a span of ticks.
+    let speed = |span: std::ops::Range<usize>| -> f64 {
+        let n = span.len() as f64;
+        span.map(|k| {
+            poses[k]
+                .pose
+                .iter()
+                .zip(&poses[k - 1].pose)
+                .map(|(a, b)| (a - b).abs() as f64)
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+            / n
+    };
+    // From 1.5 s into the silence to its end, against the speech before it.
+    let quiet = speed(tick(silence_at + 3 * rate / 2)..tick(silence_at + 4 * rate));
+    let speaking = speed(tick(rate)..tick(silence_at));
+    assert!(
+        quiet < 0.4 * speaking,
+        "the pose moves {quiet:.2} per tick in the silence, {speaking:.2} in speech"
+    );
+}
+
+/// The stroke term is what lands strokes on syllables: the same speech baked without it puts
+/// the library's strokes further from the onsets.
+#[test]
+fn the_stroke_term_lands_strokes_on_onsets() {
+    let (bytes, speech) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let rate = blob.prosody_config().sample_rate_hz;
+    let fps_milli = (blob.fps() * 1000.0).round() as u64;
+    let ticks = ticks_of(speech.len(), rate, fps_milli);
+    let tl = Timeline::of(&blob, &speech, ticks as usize).unwrap();
+    assert!(tl.onsets.len() >= 20, "{} onsets", tl.onsets.len());
+    let with = bake(&blob, &speech).unwrap().play(&blob).unwrap();
+    let off = Weights {
+        stroke_gain: 0.0,
+        ..Weights::default()
+    };
+    let without = bake_with(&blob, &speech, &off)
+        .unwrap()
+        .play(&blob)
+        .unwrap();
+    let (a, b) = (
+        stroke_alignment(&blob, &with, &tl.onsets, fps_milli),
+        stroke_alignment(&blob, &without, &tl.onsets, fps_milli),
+    );
+    assert!(a > b + 0.05, "with the stroke term {a:.3}, without {b:.3}");
+}
+
+/// Shares of a plan, counted by hand: segment 0 until tick 10, segment 1 (continued at 20)
+/// until 60, segment 2 to the end (100 ticks).
+#[test]
+fn shares_count_each_segment_from_its_entry_to_the_next() {
+    let (bytes, _) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let d = |tick, act| Planned {
+        tick,
+        exit: 0,
+        act,
+        until: 0,
+        candidates: 1,
+        cost: 0.0,
+    };
+    let plan = [
+        d(
+            10,
+            Act::Enter {
+                segment: 1,
+                rate: 1.0,
+            },
+        ),
+        d(20, Act::Continue { rate: 0.9 }),
+        d(60, Act::Rest { segment: 2 }),
+    ];
+    let s = shares(&blob, &plan, 100, 3);
+    assert_eq!(s, vec![0.1, 0.5, 0.4]);
+}
+
+/// Tick `k` is due at `ceil(k * rate * 1000 / fps_milli)` samples: one second at 16 kHz and
+/// 30 fps holds ticks 0..=30; one sample less, 0..=29.
+#[test]
+fn ticks_of_counts_the_ticks_due() {
+    assert_eq!(ticks_of(16_000, 16_000, 30_000), 31);
+    assert_eq!(ticks_of(15_999, 16_000, 30_000), 30);
+    assert_eq!(ticks_of(0, 16_000, 30_000), 1);
+    assert_eq!(ticks_of(100, 0, 30_000), 0);
+}
