@@ -47,7 +47,10 @@ def main():
         ax.set_title(title)
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
-    fig.suptitle("Known audio: 30-run means; dashed, the capture of the same speech", fontsize=10)
+    fig.suptitle(
+        "Known audio: 30-run means (all: one plan); dashed, the capture of the same speech",
+        fontsize=10,
+    )
     fig.tight_layout()
     fig.savefig(out, dpi=110)
 

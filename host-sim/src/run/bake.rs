@@ -37,7 +37,12 @@ pub fn baked(
     period_us: f32,
 ) -> Result<Simulation, String> {
     let fail = |e: String| format!("--lookahead-ms all: {e}");
-    let b = bake(blob, samples).map_err(|e| fail(e.to_string()))?;
+    // About a tenth of the audio's duration on a 2-minute file: say what is going on.
+    let progress =
+        gesture_trainer::progress::spinner("planning the whole file (--lookahead-ms all)");
+    let b = bake(blob, samples).map_err(|e| fail(e.to_string()));
+    progress.finish_and_clear();
+    let b = b?;
     let bytes = b.show(blob).map_err(|e| fail(e.to_string()))?;
     let show = Show::parse(&bytes).map_err(|e| fail(e.to_string()))?;
     let mut player = ShowPlayer::from_blob(&show, blob).map_err(|e| fail(e.to_string()))?;
@@ -68,7 +73,7 @@ pub fn baked(
                 exit_segment: x.map_or(0, |x| x.segment as usize),
                 exit_frame: x.map_or(0, |x| x.frame as usize),
                 entered: match d.act {
-                    Act::Continue { .. } => None,
+                    Act::Continue { .. } | Act::Hold => None,
                     Act::Enter { segment, .. } | Act::Rest { segment } => Some(segment),
                 },
                 candidates: d.candidates,

@@ -124,7 +124,7 @@ fn shares(blob: &Blob<'_>, plan: &[Planned], ticks: u64, segments: usize) -> Vec
     let (mut seg, mut from) = (0usize, 0u64);
     for d in plan {
         let next = match d.act {
-            Act::Continue { .. } => continue,
+            Act::Continue { .. } | Act::Hold => continue,
             Act::Enter { segment, .. } | Act::Rest { segment } => segment,
         };
         let _ = blob;
@@ -183,10 +183,15 @@ fn commands(blob: &Blob<'_>, plan: &[Planned], ticks: u64) -> Vec<(u64, PlayerCo
                     rate: r,
                 } => {
                     let a = player.segment();
-                    let run_on = blob.exit_is_end(d.exit)
+                    // Into the recorded successor from the segment's end, played forward:
+                    // no cut. After a rest (played to and fro) it is a cut.
+                    let run_on = rest_until == 0
+                        && blob.exit_is_end(d.exit)
                         && PolicyTables::exit_segment(blob, d.exit) == a
                         && c == a + 1
-                        && blob.continues(a);
+                        && blob.continues(a)
+                        && !player.backward()
+                        && player.frame() + 2 >= blob.segment_len(a);
                     give(if run_on {
                         PlayerCommand::RunOn
                     } else {
@@ -198,6 +203,7 @@ fn commands(blob: &Blob<'_>, plan: &[Planned], ticks: u64) -> Vec<(u64, PlayerCo
                     pace(r, &mut give);
                     rest_until = 0;
                 }
+                Act::Hold => rest_until = d.until,
                 Act::Rest { segment: r } => {
                     give(PlayerCommand::Enter {
                         segment: r.min(u16::MAX as usize) as u16,

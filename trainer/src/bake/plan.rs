@@ -21,13 +21,19 @@
 //!   `STROKE_GAIN` times a Gaussian (sigma `STROKE_SIGMA_S`, the width of `eval-motion`'s beat
 //!   kernel) of its distance to the nearest syllable onset;
 //! - **pace**: each choice plays at one of `RATES`, costing `PACE_COST * |ln rate|`, so a stroke
-//!   is moved only when it lands better.
+//!   is moved only when it lands better;
+//! - **cuts**: a cut waits for the hands' next pause, as live (`defer_cut_ms`), and costs
+//!   `CUT_COST` times the pose's motion per frame on its two sides (the frame cut from and the
+//!   frame cut to, over the library's median), so cuts fall where the body is still; running on
+//!   into the recorded successor is no cut.
 //!
 //! While the voice rests the calmest segments are candidates (as live) and are held, played to
-//! and fro, until the speech returns; the next decision is then the rest's exit.
+//! and fro at their rest pace, until the speech returns or they have played there and back once;
+//! then the rest holds on, or another rest takes over (a cut between calm frames), so a long
+//! pause need not show one segment throughout.
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::follow::RestSet;
+use gesture_runtime::follow::{rest_rate, RestSet};
 use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::{History, Penalties, PolicyTables, Variety, Visit, HISTORY};
 
@@ -40,6 +46,9 @@ pub struct Weights {
     pub stroke_gain: f32,
     /// Cost per unit of `|ln rate|`.
     pub pace_cost: f32,
+    /// Cost of a cut per unit of the pose's motion on its two sides (over the library's
+    /// median motion per frame).
+    pub cut_cost: f32,
 }
 
 impl Default for Weights {
@@ -47,10 +56,13 @@ impl Default for Weights {
         Self {
             stroke_gain: STROKE_GAIN,
             pace_cost: PACE_COST,
+            cut_cost: CUT_COST,
         }
     }
 }
 
+/// Cost of a cut per unit of motion carried over (see [`Weights::cut_cost`]).
+pub const CUT_COST: f32 = 0.5;
 /// The paces a choice may play at (frames per tick).
 pub const RATES: [f32; 5] = [0.8, 0.9, 1.0, 1.12, 1.25];
 /// Cost per unit of `|ln rate|` of a choice.
@@ -75,11 +87,15 @@ pub enum Act {
         /// Frames per tick.
         rate: f32,
     },
-    /// Enter a rest segment and hold it (to and fro at its rest pace) until the speech returns.
+    /// Enter a rest segment and hold it (to and fro at its rest pace) until the speech returns
+    /// or it has played there and back once.
     Rest {
         /// The rest segment.
         segment: usize,
     },
+    /// The held rest goes on (no cut) until the speech returns or it has played there and back
+    /// once more.
+    Hold,
 }
 
 /// One decision of the plan: after the pose of `tick`, at exit point `exit` (or, after a
@@ -149,6 +165,39 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
         .collect();
     let energy: Vec<f32> = (0..segments).map(|c| blob.energy(c)).collect();
     let price = |c: usize| prices.get(c).copied().unwrap_or(0.0);
+    // How fast the pose moves at each frame (degrees per frame over the channels; an angle's
+    // wrap counts the short way), over the library's median: what a cut there carries over.
+    let channels = blob.channels();
+    let motion: Vec<Vec<f32>> = (0..segments)
+        .map(|c| {
+            let len = blob.segment_len(c);
+            (0..len)
+                .map(|f| {
+                    let (a, b) = if f + 1 < len {
+                        (f, f + 1)
+                    } else {
+                        (f.saturating_sub(1), f)
+                    };
+                    (0..channels)
+                        .map(|ch| {
+                            let d = (blob.value(c, b, ch) - blob.value(c, a, ch)).abs();
+                            if d.is_finite() {
+                                d.min((360.0 - d).abs())
+                            } else {
+                                0.0
+                            }
+                        })
+                        .sum::<f32>()
+                })
+                .collect()
+        })
+        .collect();
+    let median_motion = {
+        let mut all: Vec<f32> = motion.iter().flatten().copied().collect();
+        all.sort_by(f32::total_cmp);
+        all.get(all.len() / 2).copied().unwrap_or(1.0).max(1e-6)
+    };
+    let cut_cost = w.cut_cost / median_motion;
     // Where a cut from frame `f` of segment `c` falls: the frame itself if the hands pause
     // there, else the first calm frame, else the first motion beat, else the last frame, within
     // the live controller's deferral window (`None`: none does; the cut cannot be made here).
@@ -173,6 +222,13 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
         }
         beat.or((last + 1 >= len && last > f).then_some(last))
     };
+    // Ticks a rest plays there and back at its rest pace.
+    let rest_cycle: Vec<usize> = (0..segments)
+        .map(|c| {
+            let len = blob.segment_len(c).saturating_sub(1).max(1) as f32;
+            ((2.0 * len / rest_rate(blob.energy(c)).max(0.1)).ceil() as usize).max(2)
+        })
+        .collect();
     let last_exit: Vec<usize> = (0..segments)
         .map(|c| blob.exits_of(c).end.saturating_sub(1))
         .collect();
@@ -280,25 +336,58 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                 ));
             }
             let mut worst = 0.0f32;
-            for k in 0..blob.successor_count(e) {
-                let (c, sc) = PolicyTables::successor(blob, e, k);
-                worst = worst.max(sc);
+            // After a rest, which has played to and fro, the successors of any of its exit
+            // points (each at its cheapest); at an exit point, its own.
+            let sources = if s < exits {
+                e..e + 1
+            } else {
+                blob.exits_of(playing)
+            };
+            for x in sources {
+                for k in 0..blob.successor_count(x) {
+                    let (c, sc) = PolicyTables::successor(blob, x, k);
+                    worst = worst.max(sc);
+                    let v = sc + blob.u_dot(c, b) + pen.of(c);
+                    let known = cand
+                        .iter()
+                        .position(|a| matches!(a.0, Act::Enter { segment, .. } if segment == c));
+                    match known {
+                        Some(i) if cand[i].1 <= v => {}
+                        Some(i) => cand[i] = (cand[i].0, v, x),
+                        None => cand.push((
+                            Act::Enter {
+                                segment: c,
+                                rate: 1.0,
+                            },
+                            v,
+                            x,
+                        )),
+                    }
+                }
+            }
+            if cand.is_empty() {
+                // No successor (a blob whose pruning left none): segment 0, as live.
                 cand.push((
                     Act::Enter {
-                        segment: c,
+                        segment: 0,
                         rate: 1.0,
                     },
-                    sc + blob.u_dot(c, b) + pen.of(c),
+                    0.0,
                     e,
                 ));
             }
-            if resting && s < exits {
+            if resting {
                 for &r in &extras {
-                    cand.push((
-                        Act::Rest { segment: r },
-                        worst + blob.u_dot(r, b) + pen.of(r),
-                        e,
-                    ));
+                    if s >= exits && r == playing {
+                        // Holding on costs what continuing does.
+                        cand.push((Act::Hold, blob.u_dot(r, b) + pen.usage_of(r), e));
+                    } else {
+                        cand.push((
+                            Act::Rest { segment: r },
+                            worst + blob.u_dot(r, b) + pen.of(r),
+                            e,
+                        ));
+                    }
                 }
             }
             let best = cand.iter().map(|x| x.1).fold(f32::INFINITY, f32::min);
@@ -306,30 +395,48 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                 continue;
             }
             // A cut waits for the hands' next pause, as live: the tick it falls at.
-            let cut_at = if s < exits {
+            let (cut_at, cut_frame) = if s < exits {
                 let x = blob.exit_frame(e);
                 let r_in = match here.act {
                     Some(Act::Continue { rate }) | Some(Act::Enter { rate, .. }) => rate,
                     _ => 1.0,
                 };
                 let g = pause_from(playing, x);
-                g.map(|g| t + ticks_to(x, g, r_in) * usize::from(g > x))
+                (
+                    g.map(|g| t + ticks_to(x, g, r_in) * usize::from(g > x)),
+                    g.unwrap_or(x),
+                )
             } else {
-                Some(t)
+                (Some(t), 0)
             };
+            let out_motion = motion[playing].get(cut_frame).copied().unwrap_or(0.0);
+            let run_on = s < exits && blob.exit_is_end(e) && blob.continues(playing);
             let cand_n = cand.len();
             for &(act, q, e) in &cand {
                 let base = here.cost + (q - best).max(0.0);
                 let tc = match (act, cut_at) {
-                    (Act::Continue { .. }, _) => t,
+                    (Act::Continue { .. } | Act::Hold, _) => t,
                     (_, Some(tc)) if tc < t_end => tc,
                     _ => continue,
                 };
-                // The wait plays the current segment on.
-                let base = base + price(playing) * (tc - t) as f32 / mean_interval;
+                // The wait plays the current segment on; a cut carries the motion on both
+                // sides of it (running on into the recorded successor is no cut).
+                let mut base = base + price(playing) * (tc - t) as f32 / mean_interval;
+                if let Act::Enter { segment: c, .. } | Act::Rest { segment: c } = act {
+                    if !(run_on && c == playing + 1) {
+                        let in_motion = motion[c].first().copied().unwrap_or(0.0);
+                        base += cut_cost * (out_motion + in_motion);
+                    }
+                }
                 match act {
-                    Act::Rest { segment: r } => {
-                        let until = speaks[(tc + 1).min(t_end)].max(tc + 1);
+                    Act::Rest { .. } | Act::Hold => {
+                        let r = match act {
+                            Act::Rest { segment } => segment,
+                            _ => playing,
+                        };
+                        let until = speaks[(tc + 1).min(t_end)]
+                            .max(tc + 1)
+                            .min(tc + rest_cycle[r]);
                         let k = extras.iter().position(|&x| x == r).unwrap_or(0);
                         let dur = (until - tc) as f32 / mean_interval;
                         let v = (w_mean(tc + 1, until) * energy[r] + price(r)) * dur;
@@ -418,7 +525,7 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                 last_exit[extras[s - exits]]
             };
             let until = match act {
-                Act::Rest { .. } => (at as usize / n) as u64,
+                Act::Rest { .. } | Act::Hold => (at as usize / n) as u64,
                 _ => 0,
             };
             out.push(Planned {

@@ -74,6 +74,19 @@ fn a_baked_run_rests_in_a_silence() {
     assert!(baked.commands.windows(2).all(|w| w[0].0 <= w[1].0));
     let poses = baked.play(&blob).unwrap();
     assert_eq!(poses.len() as u64, baked.ticks);
+    // Running on into the recorded successor (no blend) only ever follows its segment's
+    // last frames, played forward: never a rest played to and fro.
+    for &(k, c) in &baked.commands {
+        if c == PlayerCommand::RunOn && k > 0 && (k as usize) < poses.len() {
+            let before = &poses[k as usize - 1];
+            let len = blob.segment_len(before.segment);
+            assert!(
+                before.frame + 3 >= len && poses[k as usize].segment == before.segment + 1,
+                "run-on at tick {k} from frame {} of {len}",
+                before.frame
+            );
+        }
+    }
     let tick = |sample: usize| (sample as u64 * fps_milli / (rate as u64 * 1000)) as usize;
     // Mean change of the pose per tick (degrees over channels) over a span of ticks.
     let speed = |span: std::ops::Range<usize>| -> f64 {
@@ -123,6 +136,95 @@ fn the_stroke_term_lands_strokes_on_onsets() {
         stroke_alignment(&blob, &without, &tl.onsets, fps_milli),
     );
     assert!(a > b + 0.05, "with the stroke term {a:.3}, without {b:.3}");
+}
+
+/// The cut term is what puts cuts where the body is still: baked without it, the pose moves
+/// more at the ticks its cuts show.
+#[test]
+fn the_cut_term_puts_cuts_where_the_body_is_still() {
+    let (bytes, speech) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let at_cuts = |w: &Weights| -> f64 {
+        let b = bake_with(&blob, &speech, w).unwrap();
+        let poses = b.play(&blob).unwrap();
+        let cuts: Vec<usize> = b
+            .commands
+            .iter()
+            .filter(|(_, c)| matches!(c, PlayerCommand::Enter { .. }))
+            .map(|&(k, _)| k as usize)
+            .filter(|&k| k >= 1 && k < poses.len())
+            .collect();
+        assert!(cuts.len() >= 5, "{} cuts", cuts.len());
+        cuts.iter()
+            .map(|&k| {
+                poses[k]
+                    .pose
+                    .iter()
+                    .zip(&poses[k - 1].pose)
+                    .map(|(a, b)| (a - b).abs() as f64)
+                    .sum::<f64>()
+            })
+            .sum::<f64>()
+            / cuts.len() as f64
+    };
+    let with = at_cuts(&Weights::default());
+    let without = at_cuts(&Weights {
+        cut_cost: 0.0,
+        ..Weights::default()
+    });
+    assert!(
+        with < 0.8 * without,
+        "motion at cuts: with the cut term {with:.2}, without {without:.2}"
+    );
+}
+
+/// After a rest (played to and fro), entering the rest's recorded successor is a cut, not a
+/// run-on (which would jump from wherever the rest stands to the successor's first frame
+/// without a blend); from the end of a segment played forward it is a run-on.
+#[test]
+fn a_rest_is_left_by_a_cut_and_a_segment_end_runs_on() {
+    let (bytes, _) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let r = (0..blob.segments() - 1)
+        .find(|&c| blob.continues(c) && blob.segment_len(c) > 20)
+        .expect("a segment with a recorded successor");
+    let end = blob.exits_of(r).end - 1;
+    let d = |tick, act, until| Planned {
+        tick,
+        exit: end,
+        act,
+        until,
+        candidates: 1,
+        cost: 0.0,
+    };
+    let next = Act::Enter {
+        segment: r + 1,
+        rate: 1.0,
+    };
+    let after_rest = commands(
+        &blob,
+        &[d(10, Act::Rest { segment: r }, 20), d(20, next, 0)],
+        40,
+    );
+    assert!(after_rest.contains(&(
+        21,
+        PlayerCommand::Enter {
+            segment: (r + 1) as u16,
+            frame: 0
+        }
+    )));
+    assert!(!after_rest.iter().any(|&(_, c)| c == PlayerCommand::RunOn));
+    // Entered at tick 10 and played forward to its last frame, then on into the successor.
+    let len = blob.segment_len(r) as u64;
+    let enter = Act::Enter {
+        segment: r,
+        rate: 1.0,
+    };
+    let played = commands(&blob, &[d(10, enter, 0), d(10 + len, next, 0)], len + 30);
+    assert!(
+        played.contains(&(11 + len, PlayerCommand::RunOn)),
+        "{played:?}"
+    );
 }
 
 /// Shares of a plan, counted by hand: segment 0 until tick 10, segment 1 (continued at 20)
