@@ -3,7 +3,7 @@
 //! on the run's servo rig, so every output of the run (servo.csv, motion.bvh, the timeline,
 //! previews, VMC, `--show`) is the baked motion. The front-end's records (frames, steps and
 //! beliefs) are those of the run the caller made with the longest look-ahead. Also the
-//! show's playback on a servo rig that `play-show` uses ([`play_on`]).
+//! show's playback on a servo rig that `play-show` uses (`play_on`).
 
 use gesture_runtime::blob::Blob;
 use gesture_runtime::rig::{ChannelCal, ServoRig, MAX_CHANNELS};
@@ -40,6 +40,7 @@ pub fn baked(
     // About a tenth of the audio's duration on a 2-minute file: say what is going on.
     let progress =
         gesture_trainer::progress::spinner("planning the whole file (--lookahead-ms all)");
+    let start = std::time::Instant::now();
     let b = bake(blob, samples).map_err(|e| fail(e.to_string()));
     progress.finish_and_clear();
     let b = b?;
@@ -60,6 +61,8 @@ pub fn baked(
     sim.duties = played.duties;
     sim.angles = played.angles;
     sim.plays = b.commands;
+    // The run's time includes the planning (the summary's speed is of the whole).
+    sim.wall_s += start.elapsed().as_secs_f64();
     let fps = sim.fps.max(1e-9);
     sim.decisions = b
         .plan

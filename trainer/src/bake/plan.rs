@@ -30,7 +30,8 @@
 //! While the voice rests the calmest segments are candidates (as live) and are held, played to
 //! and fro at their rest pace, until the speech returns or they have played there and back once;
 //! then the rest holds on, or another rest takes over (a cut between calm frames), so a long
-//! pause need not show one segment throughout.
+//! pause need not show one segment throughout. A rest, played to and fro, is left by a cut to a
+//! successor of any of its exit points.
 
 use gesture_runtime::blob::Blob;
 use gesture_runtime::follow::{rest_rate, RestSet};
