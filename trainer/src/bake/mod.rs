@@ -85,7 +85,7 @@ pub fn bake_with(blob: &Blob<'_>, samples: &[i16], w: &Weights) -> Result<Baked,
     let mut kept: Option<(f32, Vec<Planned>, f32)> = None;
     for _ in 0..PRICE_ROUNDS {
         let (plan, cost) = plan::plan(blob, &tl, w, &prices);
-        let shares = shares(blob, &plan, ticks, segments);
+        let shares = shares(&plan, ticks, segments);
         let largest = shares.iter().copied().fold(0.0f32, f32::max);
         if kept.as_ref().is_none_or(|k| largest < k.0) {
             kept = Some((largest, plan, cost));
@@ -119,7 +119,7 @@ const PRICE_ROUNDS: usize = 8;
 
 /// Each segment's share of the `ticks` ticks a plan plays (a segment plays from the
 /// decision that enters it to the next that leaves it; before the first, segment 0).
-fn shares(blob: &Blob<'_>, plan: &[Planned], ticks: u64, segments: usize) -> Vec<f32> {
+fn shares(plan: &[Planned], ticks: u64, segments: usize) -> Vec<f32> {
     let mut played = vec![0u64; segments];
     let (mut seg, mut from) = (0usize, 0u64);
     for d in plan {
@@ -127,7 +127,6 @@ fn shares(blob: &Blob<'_>, plan: &[Planned], ticks: u64, segments: usize) -> Vec
             Act::Continue { .. } | Act::Hold => continue,
             Act::Enter { segment, .. } | Act::Rest { segment } => segment,
         };
-        let _ = blob;
         if let Some(p) = played.get_mut(seg) {
             *p += d.tick.min(ticks).saturating_sub(from);
         }

@@ -38,6 +38,16 @@ fn blob_and_speech() -> (Vec<u8>, Vec<i16>) {
     (packed.bytes, speech)
 }
 
+/// How much the pose changes from tick `k - 1` to tick `k` (degrees, summed over channels).
+fn pose_step(poses: &[BakedPose], k: usize) -> f64 {
+    poses[k]
+        .pose
+        .iter()
+        .zip(&poses[k - 1].pose)
+        .map(|(a, b)| (a - b).abs() as f64)
+        .sum()
+}
+
 /// Mean over the library strokes shown of the beat kernel (sigma 0.1 s) to the nearest onset.
 fn stroke_alignment(blob: &Blob<'_>, poses: &[BakedPose], onsets: &[f64], fps_milli: u64) -> f64 {
     let sigma = 0.1 * fps_milli as f64 / 1000.0;
@@ -91,16 +101,7 @@ fn a_baked_run_rests_in_a_silence() {
     // Mean change of the pose per tick (degrees over channels) over a span of ticks.
     let speed = |span: std::ops::Range<usize>| -> f64 {
         let n = span.len() as f64;
-        span.map(|k| {
-            poses[k]
-                .pose
-                .iter()
-                .zip(&poses[k - 1].pose)
-                .map(|(a, b)| (a - b).abs() as f64)
-                .sum::<f64>()
-        })
-        .sum::<f64>()
-            / n
+        span.map(|k| pose_step(&poses, k)).sum::<f64>() / n
     };
     // From 1.5 s into the silence to its end, against the speech before it.
     let quiet = speed(tick(silence_at + 3 * rate / 2)..tick(silence_at + 4 * rate));
@@ -155,17 +156,7 @@ fn the_cut_term_puts_cuts_where_the_body_is_still() {
             .filter(|&k| k >= 1 && k < poses.len())
             .collect();
         assert!(cuts.len() >= 5, "{} cuts", cuts.len());
-        cuts.iter()
-            .map(|&k| {
-                poses[k]
-                    .pose
-                    .iter()
-                    .zip(&poses[k - 1].pose)
-                    .map(|(a, b)| (a - b).abs() as f64)
-                    .sum::<f64>()
-            })
-            .sum::<f64>()
-            / cuts.len() as f64
+        cuts.iter().map(|&k| pose_step(&poses, k)).sum::<f64>() / cuts.len() as f64
     };
     let with = at_cuts(&Weights::default());
     let without = at_cuts(&Weights {
@@ -231,8 +222,6 @@ fn a_rest_is_left_by_a_cut_and_a_segment_end_runs_on() {
 /// until 60, segment 2 to the end (100 ticks).
 #[test]
 fn shares_count_each_segment_from_its_entry_to_the_next() {
-    let (bytes, _) = blob_and_speech();
-    let blob = Blob::parse(&bytes).unwrap();
     let d = |tick, act| Planned {
         tick,
         exit: 0,
@@ -252,7 +241,7 @@ fn shares_count_each_segment_from_its_entry_to_the_next() {
         d(20, Act::Continue { rate: 0.9 }),
         d(60, Act::Rest { segment: 2 }),
     ];
-    let s = shares(&blob, &plan, 100, 3);
+    let s = shares(&plan, 100, 3);
     assert_eq!(s, vec![0.1, 0.5, 0.4]);
 }
 
