@@ -37,6 +37,7 @@ use gesture_runtime::blob::Blob;
 use gesture_runtime::follow::{rest_rate, RestSet};
 use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::{History, Penalties, PolicyTables, Variety, Visit, HISTORY};
+use gesture_runtime::rotation::wrap_deg;
 
 use super::timeline::Timeline;
 
@@ -60,6 +61,22 @@ impl Default for Weights {
             cut_cost: CUT_COST,
         }
     }
+}
+
+/// How far the pose moves from frame `f` of segment `c` to the next (from the one before at
+/// the segment's last frame): degrees summed over the channels, each angle's change the short
+/// way round; a non-finite value counts as none.
+fn frame_motion(blob: &Blob<'_>, c: usize, f: usize) -> f32 {
+    let len = blob.segment_len(c);
+    let (a, b) = if f + 1 < len {
+        (f, f + 1)
+    } else {
+        (f.saturating_sub(1), f)
+    };
+    (0..blob.channels())
+        .map(|ch| wrap_deg(blob.value(c, b, ch) - blob.value(c, a, ch)).abs())
+        .filter(|d| d.is_finite())
+        .sum()
 }
 
 /// Cost of a cut per unit of motion carried over (see [`Weights::cut_cost`]).
@@ -168,28 +185,10 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
     let price = |c: usize| prices.get(c).copied().unwrap_or(0.0);
     // How fast the pose moves at each frame (degrees per frame over the channels; an angle's
     // wrap counts the short way), over the library's median: what a cut there carries over.
-    let channels = blob.channels();
     let motion: Vec<Vec<f32>> = (0..segments)
         .map(|c| {
-            let len = blob.segment_len(c);
-            (0..len)
-                .map(|f| {
-                    let (a, b) = if f + 1 < len {
-                        (f, f + 1)
-                    } else {
-                        (f.saturating_sub(1), f)
-                    };
-                    (0..channels)
-                        .map(|ch| {
-                            let d = (blob.value(c, b, ch) - blob.value(c, a, ch)).abs();
-                            if d.is_finite() {
-                                d.min((360.0 - d).abs())
-                            } else {
-                                0.0
-                            }
-                        })
-                        .sum::<f32>()
-                })
+            (0..blob.segment_len(c))
+                .map(|f| frame_motion(blob, c, f))
                 .collect()
         })
         .collect();
