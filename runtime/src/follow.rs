@@ -77,6 +77,45 @@ impl VoiceFollow {
     };
 }
 
+/// How much a gesture's size follows the voice: the player's expression stage
+/// ([`crate::player::expression`]) shows the quick part of the motion `1 + span * v` times its
+/// size while speaking (`v` the last syllable's level over [`VOICE_SPAN`], clamped to -1..1)
+/// and `pause` times from the first pause step of a silence.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Expressive {
+    /// Gain above or below 1 at full voice level (each way).
+    pub span: f32,
+    /// Gain in a silence.
+    pub pause: f32,
+}
+
+impl Expressive {
+    /// The frames as they are.
+    pub const NONE: Self = Self {
+        span: 0.0,
+        pause: 1.0,
+    };
+
+    /// The expression of a blob that follows the voice as `follow` says: [`EXPRESSION`], or
+    /// none under the paper's rule ([`VoiceFollow::NONE`]).
+    pub fn of(follow: &VoiceFollow) -> Self {
+        if *follow == VoiceFollow::NONE {
+            Self::NONE
+        } else {
+            EXPRESSION
+        }
+    }
+}
+
+/// The expression of a blob that follows the voice: 30 % larger at full voice level (5 dB
+/// above the speaker's running level), 30 % smaller at the other end, half size in a silence.
+/// A third either way stays within how much one speaker's strokes vary in size between calm
+/// and emphatic phrases; chosen on tuning speech (docs/method.md).
+pub const EXPRESSION: Expressive = Expressive {
+    span: 0.3,
+    pause: 0.5,
+};
+
 /// How fast a rest moves at most: this share of the library's median hand speed (a segment's
 /// energy `ln(REST_SPEED)` or less plays at its own pace while resting).
 pub const REST_SPEED: f32 = 0.2;
@@ -168,6 +207,25 @@ impl Voice {
     /// What changed since the last call, once.
     pub fn take_change(&mut self) -> Option<VoiceChange> {
         self.change.take()
+    }
+
+    /// The expression gain the voice asks for now ([`Expressive`]): `e.pause` from the
+    /// first pause step of a silence, else `1 + e.span * clamp(level / VOICE_SPAN, -1, 1)`,
+    /// the span scaled by `share` (the style's neutral share: a tone the user chose sets the
+    /// body's energy); within the player's
+    /// [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not finite.
+    pub fn gain(&self, e: &Expressive, share: f32) -> f32 {
+        let g = if self.resting || self.silent_steps > 0 {
+            e.pause
+        } else {
+            1.0 + e.span * share * (self.level / VOICE_SPAN).clamp(-1.0, 1.0)
+        };
+        let (lo, hi) = crate::player::expression::GAIN_RANGE;
+        if g.is_finite() {
+            g.clamp(lo, hi)
+        } else {
+            1.0
+        }
     }
 
     /// The energy weight `w` of a decision now (see the module docs).

@@ -1,12 +1,13 @@
 //! The body follows the voice (`gesture_runtime::follow`) through the whole controller: in a
 //! pause the character moves to the calmest segments even when no successor list holds one,
 //! holds the rest (played to and fro, never frozen) until the speech returns, and then cuts
-//! into a gesture at once; without it (`VoiceFollow::NONE`) the paper's rule keeps gesturing.
+//! into a gesture at once, the gesture shrinking in the silence and growing back with the
+//! speech; without it (`VoiceFollow::NONE`) the paper's rule keeps gesturing.
 
 use gesture_runtime::controller::{Controller, ControllerEvent};
-use gesture_runtime::follow::VoiceFollow;
+use gesture_runtime::follow::{VoiceFollow, EXPRESSION};
 use gesture_runtime::inference::{CrfWeights, GmmComponent, I16Table};
-use gesture_runtime::player::LibraryFrames;
+use gesture_runtime::player::{LibraryFrames, PlayerCommand};
 use gesture_runtime::policy::{PolicyTables, Variety};
 use gesture_runtime::prosody::ProsodyConfig;
 
@@ -121,6 +122,8 @@ struct Tick {
     pose: f32,
     decided: bool,
     onset: bool,
+    /// The expression gain aimed at from this tick on, when the controller changed it.
+    gain: Option<f32>,
 }
 
 fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
@@ -144,7 +147,12 @@ fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
     c.set_follow(follow);
     let mut ticks: Vec<Tick> = Vec::new();
     let mut heard = false;
+    let mut gain = None;
     let mut sink = |e: ControllerEvent<'_>| match e {
+        ControllerEvent::Play {
+            command: PlayerCommand::Gain(g),
+            ..
+        } => gain = Some(g),
         ControllerEvent::Pose {
             segment,
             frame,
@@ -157,6 +165,7 @@ fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
                 pose: pose[0],
                 decided: false,
                 onset: heard,
+                gain: gain.take(),
             });
             heard = false;
         }
@@ -237,6 +246,52 @@ fn without_following_the_voice_a_pause_plays_gestures() {
         ..FOLLOW
     };
     assert!(run(&samples, no_cost).iter().all(|t| !rest(t.segment)));
+}
+
+#[test]
+fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
+    // Speech 0-3 s, silence 3-7 s, speech 7-9 s.
+    let samples = audio(9.0, |t| !(3.0..7.0).contains(&t));
+    let ticks = run(&samples, FOLLOW);
+    let at = |s: f32| (s * 30.0) as usize;
+    let aims: Vec<(usize, f32)> = ticks
+        .iter()
+        .enumerate()
+        .filter_map(|(i, t)| t.gain.map(|g| (i, g)))
+        .collect();
+    let (lo, hi) = (1.0 - EXPRESSION.span, 1.0 + EXPRESSION.span);
+    // While speaking, within the voice's span (a first syllable's level moves it).
+    assert!(aims.iter().any(|&(i, _)| i < at(3.0)), "{aims:?}");
+    for &(i, g) in aims.iter().filter(|&&(i, _)| i < at(3.0)) {
+        assert!((lo..=hi).contains(&g), "gain {g} at tick {i}");
+    }
+    // The first pause step of the silence (a quarter second, reported at its end) halves the
+    // gesture: well before the rest (0.5 s).
+    let shrink = aims
+        .iter()
+        .find(|&&(i, g)| i >= at(3.0) && g == EXPRESSION.pause)
+        .copied()
+        .unwrap();
+    assert!(
+        shrink.0 <= at(3.45),
+        "shrunk at tick {}: {aims:?}",
+        shrink.0
+    );
+    // Held through the silence; back within the span on the speech's first onset.
+    assert!(!aims
+        .iter()
+        .any(|&(i, _)| (shrink.0 + 1..at(6.9)).contains(&i)));
+    let back = (at(6.9)..ticks.len()).find(|&i| ticks[i].onset).unwrap();
+    let grown = aims.iter().find(|&&(i, _)| i >= at(6.9)).copied().unwrap();
+    assert!(
+        grown.0 <= back + 1,
+        "grown at tick {}, onset {back}",
+        grown.0
+    );
+    assert!((lo..=hi).contains(&grown.1), "{grown:?}");
+    // Without following the voice, the frames as they are.
+    let none = run(&samples, VoiceFollow::NONE);
+    assert!(none.iter().all(|t| t.gain.is_none()));
 }
 
 #[test]

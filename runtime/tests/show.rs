@@ -199,8 +199,8 @@ fn play<L: LibraryFrames + ?Sized>(
     out
 }
 
-fn kinds(plays: &[(u64, PlayerCommand)]) -> [usize; 5] {
-    let mut k = [0; 5];
+fn kinds(plays: &[(u64, PlayerCommand)]) -> [usize; 6] {
+    let mut k = [0; 6];
     for (_, c) in plays {
         k[match c {
             PlayerCommand::Enter { .. } => 0,
@@ -208,6 +208,7 @@ fn kinds(plays: &[(u64, PlayerCommand)]) -> [usize; 5] {
             PlayerCommand::Turn => 2,
             PlayerCommand::Rate(_) => 3,
             PlayerCommand::Hold => 4,
+            PlayerCommand::Gain(_) => 5,
         }] += 1;
     }
     k
@@ -245,8 +246,8 @@ fn a_show_of_a_run_over_a_hand_built_library_replays_its_poses_exactly() {
     let run = record(&mut c, &samples, 160);
     let k = kinds(&run.plays);
     assert!(
-        k[0] > 0 && k[2] > 0 && k[3] > 0 && k[4] > 0,
-        "cuts, turns, rates and holds all happen: {k:?}"
+        k[0] > 0 && k[2] > 0 && k[3] > 0 && k[4] > 0 && k[5] > 0,
+        "cuts, turns, rates, holds and gains all happen: {k:?}"
     );
     let info = ShowInfo {
         blob_crc: 0,
@@ -329,6 +330,7 @@ fn command() -> impl Strategy<Value = PlayerCommand> {
         Just(PlayerCommand::Turn),
         (0.5f32..=1.5).prop_map(PlayerCommand::Rate),
         Just(PlayerCommand::Hold),
+        (0.0f32..=2.0).prop_map(PlayerCommand::Gain),
     ]
 }
 

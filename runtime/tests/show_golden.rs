@@ -66,7 +66,7 @@ fn the_documented_bytes_parse_to_the_documented_show() {
     let h = show.header();
     assert_eq!(
         (h.version, h.blob_crc, h.sample_rate_hz, h.fps_milli),
-        (1, 0xea7c_7223, 16_000, 30_000)
+        (2, 0xea7c_7223, 16_000, 30_000)
     );
     assert_eq!((h.ticks, h.commands, h.records_len), (12, 6, 18));
     assert_eq!(show.commands().collect::<Vec<_>>(), PLAYS);
@@ -135,8 +135,8 @@ fn every_rule_refuses_its_mutation_of_the_example() {
         (good[..35].to_vec(), ShowError::TooShort { len: 35 }),
         (mutated(|b| b[3] = b'B'), ShowError::BadMagic),
         (
-            mutated(|b| b[4] = 2),
-            ShowError::UnsupportedVersion { found: 2 },
+            mutated(|b| b[4] = 1),
+            ShowError::UnsupportedVersion { found: 1 },
         ),
         (
             mutated(|b| b[6] = 1),
@@ -174,15 +174,23 @@ fn every_rule_refuses_its_mutation_of_the_example() {
             ShowError::BadRecord { command: 5 },
         ),
         (
-            mutated(|b| b[42] = 0x05),
+            mutated(|b| b[42] = 0x06),
             ShowError::UnknownKind {
                 command: 2,
-                kind: 5,
+                kind: 6,
             },
         ),
         (
             mutated(|b| b[38..42].copy_from_slice(&1.75f32.to_le_bytes())),
             ShowError::BadRate { command: 1 },
+        ),
+        // The rate record made a gain (kind 5) of 2.5.
+        (
+            mutated(|b| {
+                b[37] = 3 << 3 | 5;
+                b[38..42].copy_from_slice(&2.5f32.to_le_bytes());
+            }),
+            ShowError::BadGain { command: 1 },
         ),
         (
             mutated(|b| b[20..24].copy_from_slice(&9u32.to_le_bytes())),

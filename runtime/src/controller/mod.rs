@@ -67,7 +67,7 @@ mod labels;
 mod settings;
 
 use crate::blob::Blob;
-use crate::follow::{RestSet, Voice, VoiceChange, VoiceFollow};
+use crate::follow::{Expressive, RestSet, Voice, VoiceChange, VoiceFollow};
 use crate::inference::{
     memberships, Belief, CrfWeights, GmmComponent, StepNormalizer, MAX_CLUSTERS, MAX_STATES,
 };
@@ -150,6 +150,8 @@ pub struct Controller<
     deferred: Option<Deferred>,
     /// How the character follows the voice.
     follow: VoiceFollow,
+    /// How a gesture's size follows the voice (the player's expression stage).
+    expression: Expressive,
     /// The voice as followed: silence, level, rest.
     voice: Voice,
     /// The calmest segments (candidates while resting).
@@ -202,6 +204,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             waited: 0,
             deferred: None,
             follow: VoiceFollow::NONE,
+            expression: Expressive::NONE,
             voice: Voice::new(),
             rest: RestSet::EMPTY,
             pause_ms: config.syllables.pause_frames.saturating_mul(10),
@@ -393,6 +396,14 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             sink(ControllerEvent::Play {
                 tick: self.ticks,
                 command,
+            });
+        }
+        let gain = self.voice.gain(&self.expression, self.style.neutral());
+        if gain != self.player.gain_aim() {
+            self.player.set_gain(gain);
+            sink(ControllerEvent::Play {
+                tick: self.ticks,
+                command: PlayerCommand::Gain(self.player.gain_aim()),
             });
         }
         if hold {

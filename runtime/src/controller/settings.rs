@@ -2,7 +2,7 @@
 //! voice, varies, styles, serves labels, times its decisions and looks ahead.
 
 use super::{Controller, DecisionTiming, LabelError, Lookahead};
-use crate::follow::{RestSet, VoiceFollow};
+use crate::follow::{Expressive, RestSet, VoiceFollow};
 use crate::inference::MAX_STATES;
 use crate::player::LibraryFrames;
 use crate::policy::{PolicyTables, Style, StyleError, Variety};
@@ -40,11 +40,23 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     /// [`crate::follow`]).
     pub fn set_follow(&mut self, follow: VoiceFollow) {
         self.follow = follow;
+        self.expression = Expressive::of(&follow);
         self.rest = if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
             RestSet::of(self.tables, self.lib.segment_count())
         } else {
             RestSet::EMPTY
         };
+    }
+
+    /// Sets how a gesture's size follows the voice (set by [`set_follow`](Self::set_follow):
+    /// [`Expressive::of`](crate::follow::Expressive::of) the blob's voice following); an evaluation's ablation sets [`Expressive::NONE`](crate::follow::Expressive::NONE).
+    pub fn set_expression(&mut self, e: Expressive) {
+        self.expression = e;
+    }
+
+    /// How a gesture's size follows the voice.
+    pub fn expression(&self) -> Expressive {
+        self.expression
     }
 
     /// How the character follows the voice.

@@ -45,7 +45,10 @@
 //! every output value is finite (non-finite library values are replaced by the previous
 //! output, non-finite offsets by none).
 
+pub mod expression;
 mod library;
+
+use expression::Expression;
 
 pub use library::{library_speed_cap, within_limits, LibraryFrames};
 
@@ -97,6 +100,8 @@ pub enum PlayerCommand {
     Turn,
     /// [`Player::set_rate`]: frames per tick from this tick on.
     Rate(f32),
+    /// [`Player::set_gain`]: the expression gain aimed at from this tick on.
+    Gain(f32),
     /// This tick shows the same frame again ([`Player::tick_advancing`] with `advance` false).
     Hold,
 }
@@ -114,6 +119,7 @@ impl Player {
             PlayerCommand::RunOn => self.run_on(lib),
             PlayerCommand::Turn => self.turn(),
             PlayerCommand::Rate(r) => self.set_rate(r),
+            PlayerCommand::Gain(g) => self.set_gain(g),
             PlayerCommand::Hold => {}
         }
     }
@@ -146,6 +152,8 @@ pub struct Player {
     phase: f32,
     /// Playing the segment backwards (see [`Player::turn`]).
     backward: bool,
+    /// The expression stage after the blend ([`expression`]).
+    expression: Expression,
 }
 
 impl Player {
@@ -168,7 +176,25 @@ impl Player {
             rate: 1.0,
             phase: 0.0,
             backward: false,
+            expression: Expression::new(),
         }
+    }
+
+    /// Aims the expression gain: the quick part of the motion (around its slow part) is shown
+    /// this many times its size from now on, eased in over [`expression::GAIN_S`]; 1 shows
+    /// the frames. Clamped into [`expression::GAIN_RANGE`]; a non-finite gain is ignored.
+    pub fn set_gain(&mut self, gain: f32) {
+        self.expression.aim(gain);
+    }
+
+    /// The expression gain aimed at ([`set_gain`](Self::set_gain)).
+    pub fn gain_aim(&self) -> f32 {
+        self.expression.aimed()
+    }
+
+    /// The expression gain this tick (easing towards its aim).
+    pub fn gain(&self) -> f32 {
+        self.expression.gain()
     }
 
     /// Turns playback around: from a segment's last frame it plays back towards its first,
@@ -469,6 +495,9 @@ impl Player {
             self.prev[ch] = self.last[ch];
             self.last[ch] = *o;
         }
+        // `last` is the player's own pose (what the next cut blends from); what is shown has
+        // the expression stage on top.
+        self.expression.apply(lib, out, n);
         self.outputs = self.outputs.saturating_add(1);
         if advance {
             // Frame counts stay far below 2^24, so the position is exact in f32.
@@ -497,7 +526,7 @@ impl Player {
 /// Of the two Euler decompositions of one rotation (`(a, b, c)` and
 /// `(a + 180, 180 - b, c + 180)`, wrapped), the one closer to `near`, each angle then moved by
 /// whole turns to lie within 180 degrees of `near`'s.
-fn nearest_euler(angles: [f32; 3], near: [f32; 3], order: [usize; 3]) -> [f32; 3] {
+pub(crate) fn nearest_euler(angles: [f32; 3], near: [f32; 3], order: [usize; 3]) -> [f32; 3] {
     // The second solution's middle angle: 180 - b for cyclic orders (b = asin(+-m)), which is
     // the same rotation because R_i(a + 180) R_j(180 - b) R_k(c + 180) = R_i(a) R_j(b) R_k(c).
     let _ = order;

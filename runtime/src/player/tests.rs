@@ -348,3 +348,141 @@ fn nearest_euler_prefers_the_solution_close_to_the_frame() {
         assert!((a - b).abs() < 1e-2, "{near:?}");
     }
 }
+
+/// One 30 s segment at 30 fps: channel 0 a single angle `20 + 15 sin(w f)`, channels 1-3 a
+/// rotation group (Z, Y, X) turning `30 + 15 sin(w f)` about its first axis only, `w` one
+/// cycle per second.
+struct Sine;
+
+const SINE_W: f64 = 2.0 * core::f64::consts::PI / 30.0;
+
+impl LibraryFrames for Sine {
+    fn channels(&self) -> usize {
+        4
+    }
+    fn fps(&self) -> f32 {
+        30.0
+    }
+    fn segment_count(&self) -> usize {
+        1
+    }
+    fn segment_len(&self, _: usize) -> usize {
+        900
+    }
+    fn value(&self, _: usize, f: usize, ch: usize) -> f32 {
+        let s = 15.0 * (SINE_W * f as f64).sin() as f32;
+        match ch {
+            0 => 20.0 + s,
+            1 => 30.0 + s,
+            _ => 0.0,
+        }
+    }
+    fn group_count(&self) -> usize {
+        1
+    }
+    fn group(&self, _: usize) -> (usize, [u8; 3]) {
+        (1, [2, 1, 0])
+    }
+}
+
+/// The mean and the amplitude of channel `ch` at the sine's frequency over ticks
+/// `from..from + 300` (ten whole cycles: the projection is exact for a pure sine).
+fn mean_and_amplitude(p: &mut Player, from: usize, ch: usize) -> (f64, f64) {
+    let mut out = [0.0; MAX_CHANNELS];
+    let (mut m, mut a, mut b) = (0.0f64, 0.0f64, 0.0f64);
+    for k in 0..from + 300 {
+        p.tick(&Sine, &mut out);
+        if k >= from {
+            let v = out[ch] as f64;
+            m += v / 300.0;
+            a += v * (SINE_W * k as f64).sin() * 2.0 / 300.0;
+            b += v * (SINE_W * k as f64).cos() * 2.0 / 300.0;
+        }
+    }
+    (m, (a * a + b * b).sqrt())
+}
+
+/// Known answer: with the slow part `s(n) = s(n-1) + k (x(n) - s(n-1))` and the shown
+/// `x(n) + (g - 1) (x(n) - s(n-1))`, a sine of amplitude `A` is shown with amplitude
+/// `A |1 + (g - 1) (1 - k e^-iw / (1 - (1 - k) e^-iw))|` around the same mean, for a single
+/// angle and for a rotation about one axis alike; a gain of 1 shows the frames exactly.
+#[test]
+fn the_expression_gain_scales_the_quick_part_around_the_posture() {
+    let k = 1.0 - (-1.0 / (expression::SLOW_S as f64 * 30.0)).exp();
+    let response = |g: f64| {
+        // e^-iw = (c, -s); the low-pass's delayed response k e^-iw / (1 - (1 - k) e^-iw).
+        let (c, s) = (SINE_W.cos(), SINE_W.sin());
+        let (dr, di) = (1.0 - (1.0 - k) * c, (1.0 - k) * s);
+        let (nr, ni) = (k * c, -k * s);
+        let den = dr * dr + di * di;
+        let (lr, li) = ((nr * dr + ni * di) / den, (ni * dr - nr * di) / den);
+        let (hr, hi) = (1.0 + (g - 1.0) * (1.0 - lr), -(g - 1.0) * li);
+        (hr * hr + hi * hi).sqrt()
+    };
+    for g in [0.5f32, 1.3] {
+        let mut p = Player::new();
+        p.set_gain(g);
+        for (ch, mean) in [(0, 20.0), (1, 30.0)] {
+            let mut q = p;
+            let (m, amp) = mean_and_amplitude(&mut q, 300, ch);
+            let want = 15.0 * response(g as f64);
+            assert!(
+                (amp - want).abs() < 0.02,
+                "gain {g} ch {ch}: {amp} vs {want}"
+            );
+            assert!((m - mean).abs() < 0.02, "gain {g} ch {ch}: mean {m}");
+        }
+        // The other two angles of the group stay at 0: a rotation about one axis, scaled.
+        let mut out = [0.0; MAX_CHANNELS];
+        let mut q = p;
+        for _ in 0..400 {
+            q.tick(&Sine, &mut out);
+            assert!(
+                out[2].abs() < 1e-3 && out[3].abs() < 1e-3,
+                "{:?}",
+                &out[..4]
+            );
+        }
+    }
+    assert!(response(1.3) > 1.15 && response(0.5) < 0.7);
+    // A gain of 1: the frames themselves.
+    let mut p = Player::new();
+    p.set_gain(1.0);
+    let mut out = [0.0; MAX_CHANNELS];
+    for f in 0..100 {
+        p.tick(&Sine, &mut out);
+        for (ch, v) in out.iter().enumerate().take(4) {
+            assert_eq!(*v, Sine.value(0, f, ch));
+        }
+    }
+}
+
+/// The gain eases to its aim through three first-order stages: it first moves by `k^3` of
+/// the change (`k = 1 - e^(-1 / (GAIN_S fps))`), then monotonically, and is there (within
+/// the snap of 0.001) in two thirds of a second; a non-finite aim is ignored and aims are
+/// clamped.
+#[test]
+fn the_expression_gain_eases_to_its_aim() {
+    let k = 1.0 - (-1.0f32 / (expression::GAIN_S * 30.0)).exp();
+    let mut p = Player::new();
+    let mut out = [0.0; MAX_CHANNELS];
+    p.tick(&Sine, &mut out);
+    p.set_gain(0.5);
+    p.set_gain(f32::NAN);
+    assert_eq!(p.gain_aim(), 0.5);
+    p.tick(&Sine, &mut out);
+    assert!(
+        (p.gain() - (1.0 - 0.5 * k * k * k)).abs() < 1e-5,
+        "{}",
+        p.gain()
+    );
+    let mut last = p.gain();
+    for _ in 0..19 {
+        p.tick(&Sine, &mut out);
+        assert!(p.gain() < last || p.gain() == 0.5);
+        last = p.gain();
+    }
+    assert_eq!(p.gain(), 0.5);
+    p.set_gain(7.0);
+    assert_eq!(p.gain_aim(), expression::GAIN_RANGE.1);
+}

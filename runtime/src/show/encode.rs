@@ -116,6 +116,7 @@ pub fn encode_show(
             PlayerCommand::Turn => kind::TURN,
             PlayerCommand::Rate(_) => kind::RATE,
             PlayerCommand::Hold => kind::HOLD,
+            PlayerCommand::Gain(_) => kind::GAIN,
         };
         write_varint(&mut records, delta << 3 | k as u32);
         match c {
@@ -123,7 +124,9 @@ pub fn encode_show(
                 records.extend_from_slice(&segment.to_le_bytes());
                 records.extend_from_slice(&frame.to_le_bytes());
             }
-            PlayerCommand::Rate(r) => records.extend_from_slice(&r.to_le_bytes()),
+            PlayerCommand::Rate(r) | PlayerCommand::Gain(r) => {
+                records.extend_from_slice(&r.to_le_bytes())
+            }
             _ => {}
         }
         prev = tick;

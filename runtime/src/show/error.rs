@@ -23,7 +23,7 @@ pub enum ShowError {
         /// Version in the header.
         found: u16,
     },
-    /// Header flags this runtime does not know (version 1 defines none).
+    /// Header flags this runtime does not know (version 2 defines none).
     UnsupportedFlags {
         /// Flags in the header.
         found: u16,
@@ -67,7 +67,7 @@ pub enum ShowError {
         /// Index of the record (0-based).
         command: u32,
     },
-    /// A record's kind is not one of the five.
+    /// A record's kind is not one of the six.
     UnknownKind {
         /// Index of the record.
         command: u32,
@@ -76,6 +76,11 @@ pub enum ShowError {
     },
     /// A rate is not finite or outside the player's 0.5..=1.5.
     BadRate {
+        /// Index of the record.
+        command: u32,
+    },
+    /// A gain is not finite or outside the expression stage's 0..=2.
+    BadGain {
         /// Index of the record.
         command: u32,
     },
@@ -154,6 +159,7 @@ impl ShowError {
             Self::BadRecord { .. } => "BadRecord",
             Self::UnknownKind { .. } => "UnknownKind",
             Self::BadRate { .. } => "BadRate",
+            Self::BadGain { .. } => "BadGain",
             Self::TickOutOfRange { .. } => "TickOutOfRange",
             Self::CommandCount { .. } => "CommandCount",
             Self::OtherBlob { .. } => "OtherBlob",
@@ -217,6 +223,9 @@ impl fmt::Display for ShowError {
             }
             Self::BadRate { command } => {
                 write!(f, "command {command}: rate not finite or outside 0.5..=1.5")
+            }
+            Self::BadGain { command } => {
+                write!(f, "command {command}: gain not finite or outside 0..=2")
             }
             Self::TickOutOfRange { command, tick } => write!(
                 f,

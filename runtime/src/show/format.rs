@@ -5,7 +5,7 @@
 pub const SHOW_MAGIC: [u8; 4] = *b"GSTS";
 
 /// The show format version this runtime reads and writes.
-pub const SHOW_VERSION: u16 = 1;
+pub const SHOW_VERSION: u16 = 2;
 
 /// Bytes before the records: magic, version, flags, blob CRC, sample rate, fps, ticks,
 /// commands, records length.
@@ -32,6 +32,8 @@ pub(crate) mod kind {
     pub const RATE: u8 = 3;
     /// `Hold`.
     pub const HOLD: u8 = 4;
+    /// `Gain(f32)`: an `f32` follows.
+    pub const GAIN: u8 = 5;
 }
 
 /// Reads an unsigned LEB128 number of at most 32 bits in its shortest form at `bytes[*pos..]`,

@@ -7,6 +7,7 @@ use super::format::{
     SHOW_RATE_RANGE, SHOW_VERSION,
 };
 use crate::blob::{crc32, Blob};
+use crate::player::expression::GAIN_RANGE;
 use crate::player::{LibraryFrames, PlayerCommand, MAX_RATE, MIN_RATE};
 
 /// The header's fields (docs/show-format.md, section 1).
@@ -65,6 +66,14 @@ fn record(
             PlayerCommand::Rate(r)
         }
         kind::HOLD => PlayerCommand::Hold,
+        kind::GAIN => {
+            let g = f32::from_le_bytes(read_array::<4>(bytes, pos).ok_or(bad)?);
+            let (lo, hi) = GAIN_RANGE;
+            if !(g.is_finite() && (lo..=hi).contains(&g)) {
+                return Err(ShowError::BadGain { command });
+            }
+            PlayerCommand::Gain(g)
+        }
         k => return Err(ShowError::UnknownKind { command, kind: k }),
     };
     Ok((tick, cmd))

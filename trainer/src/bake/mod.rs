@@ -100,7 +100,7 @@ pub fn bake_with(blob: &Blob<'_>, samples: &[i16], w: &Weights) -> Result<Baked,
         }
     }
     let (_, plan, cost) = kept.unwrap_or((0.0, Vec::new(), 0.0));
-    let commands = commands(blob, &plan, ticks);
+    let commands = commands(blob, &plan, ticks, &tl.gain);
     Ok(Baked {
         plan,
         cost,
@@ -144,8 +144,14 @@ fn shares(plan: &[Planned], ticks: u64, segments: usize) -> Vec<f32> {
 
 /// The player's commands that carry out `plan` over `ticks` ticks: each decision's after the
 /// pose of its tick; a rest played to and fro (turned at its last frame; the player turns
-/// forward at its first by itself) until the speech returns.
-fn commands(blob: &Blob<'_>, plan: &[Planned], ticks: u64) -> Vec<(u64, PlayerCommand)> {
+/// forward at its first by itself) until the speech returns; the expression gain the voice
+/// asks for at each tick (`gain`, as the live controller aims it), before its pose.
+fn commands(
+    blob: &Blob<'_>,
+    plan: &[Planned],
+    ticks: u64,
+    gain: &[f32],
+) -> Vec<(u64, PlayerCommand)> {
     let mut out: Vec<(u64, PlayerCommand)> = Vec::new();
     let mut player = Player::new();
     let fps_milli = (blob.fps() * 1000.0).round() as u64;
@@ -157,6 +163,11 @@ fn commands(blob: &Blob<'_>, plan: &[Planned], ticks: u64) -> Vec<(u64, PlayerCo
     let mut rate = 1.0f32;
     let mut rest_until = 0u64;
     for k in 0..ticks {
+        if let Some(&g) = gain.get(k as usize) {
+            if g != player.gain_aim() {
+                out.push((k, PlayerCommand::Gain(g)));
+            }
+        }
         while applied < out.len() && out[applied].0 <= k {
             player.apply(blob, out[applied].1);
             applied += 1;

@@ -196,6 +196,7 @@ fn a_rest_is_left_by_a_cut_and_a_segment_end_runs_on() {
         &blob,
         &[d(10, Act::Rest { segment: r }, 20), d(20, next, 0)],
         40,
+        &[],
     );
     assert!(after_rest.contains(&(
         21,
@@ -211,7 +212,12 @@ fn a_rest_is_left_by_a_cut_and_a_segment_end_runs_on() {
         segment: r,
         rate: 1.0,
     };
-    let played = commands(&blob, &[d(10, enter, 0), d(10 + len, next, 0)], len + 30);
+    let played = commands(
+        &blob,
+        &[d(10, enter, 0), d(10 + len, next, 0)],
+        len + 30,
+        &[],
+    );
     assert!(
         played.contains(&(11 + len, PlayerCommand::RunOn)),
         "{played:?}"

@@ -9,7 +9,7 @@
 
 use gesture_runtime::blob::Blob;
 use gesture_runtime::controller::{BlobController, ControllerEvent};
-use gesture_runtime::follow::{Voice, VoiceFollow};
+use gesture_runtime::follow::{Expressive, Voice, VoiceFollow};
 use gesture_runtime::inference::StepNormalizer;
 use gesture_runtime::prosody::StepKind;
 
@@ -29,6 +29,8 @@ pub struct Timeline {
     pub resting: Vec<bool>,
     /// Per tick: the voice's energy weight of a decision (`follow::Voice::weight`).
     pub weight: Vec<f32>,
+    /// Per tick: the expression gain the voice asks for (`follow::Voice::gain`).
+    pub gain: Vec<f32>,
     /// Per tick: index into `beliefs` of the step spoken then.
     pub belief_at: Vec<usize>,
     /// The belief after each step (at least one: the uniform belief when there is no step).
@@ -99,7 +101,9 @@ impl Timeline {
             .pause_frames
             .saturating_mul(10);
         let mut voice = Voice::new();
-        let (mut resting, mut weight, mut belief_at) = (
+        let expression = Expressive::of(&follow);
+        let (mut resting, mut weight, mut gain, mut belief_at) = (
+            Vec::with_capacity(ticks),
             Vec::with_capacity(ticks),
             Vec::with_capacity(ticks),
             Vec::with_capacity(ticks),
@@ -118,6 +122,8 @@ impl Timeline {
             }
             resting.push(voice.resting());
             weight.push(voice.weight(&follow));
+            // The plan is for the neutral style.
+            gain.push(voice.gain(&expression, 1.0));
             belief_at.push(step);
         }
         let mut beliefs: Vec<Vec<f32>> = steps.into_iter().map(|(_, b)| b).collect();
@@ -129,6 +135,7 @@ impl Timeline {
             fps_milli,
             resting,
             weight,
+            gain,
             belief_at,
             beliefs,
             onsets,
