@@ -12,21 +12,21 @@
 //!   neutral pose, and a gain of 1 shows the frames exactly.
 //! - The gain eases to the value the controller aims it at with a time constant of
 //!   [`GAIN_S`]; a change of gain moves the hands by at most the quick part's size, smoothly.
-//! - A rotation group (a joint's three Euler angles) is scaled as a rotation: the quick part is
-//!   the rotation vector from the slow rotation to the pose's, scaled and applied to the pose
-//!   (`exp((g - 1) d) q`), and the slow rotation moves along it (`exp(k d) q_slow`); single
-//!   angles are scaled in degrees, the wrapped difference.
+//! - Every channel is scaled in degrees, as the player blends single angles. A rotation
+//!   group's three Euler angles (which the player keeps continuous) are scaled alike: for a
+//!   quick part of a few tens of degrees away from the group's gimbal lock that is the
+//!   rotation scaled. Near the lock (the middle angle within [`GIMBAL_FADE`] of +-90 degrees) a
+//!   small rotation swings the outer two angles far and in opposite ways, so the gain fades to
+//!   none there. Scaling the rotation vector itself (quaternions) was built first: the same
+//!   motion, but 3.4 KB more code on the boards, past the 96 KiB budget.
 //!
 //! The stage comes after the player's blend and rate, so a cut's inertialization and the
 //! speed cap work on the library's frames as before; the slow part is continuous across cuts.
 //! State: one value per channel and the gain; no allocation, no panics; a non-finite result
 //! leaves the channel as the player gave it.
 
-use super::{nearest_euler, LibraryFrames, MAX_CHANNELS};
-use crate::rotation::{
-    euler_angles, euler_matrix, quat_conj, quat_exp, quat_log, quat_matrix, quat_mul, quaternion,
-    wrap_deg,
-};
+use super::{LibraryFrames, MAX_CHANNELS};
+use crate::rotation::wrap_deg;
 
 /// Time constant of the slow part (s): a stroke (a quarter to half a second) is quick, the
 /// posture held over a phrase is slow.
@@ -41,6 +41,10 @@ pub const GAIN_S: f32 = 0.05;
 /// The lowest and highest gain the stage takes.
 pub const GAIN_RANGE: (f32, f32) = (0.0, 2.0);
 
+/// A rotation group's middle angle (degrees from its nearest 0 or 180) up to which the gain
+/// applies in full, and from which it does not apply (faded linearly between).
+pub const GIMBAL_FADE: (f32, f32) = (60.0, 80.0);
+
 /// A gain this close to its aim is at its aim (so a steady gain of 1 shows the frames).
 const GAIN_EPSILON: f32 = 1.0e-3;
 
@@ -53,6 +57,10 @@ pub(super) struct Expression {
     started: bool,
     /// The gain's three easing stages; the last is the gain.
     stages: [f32; 3],
+    /// Per tick: the slow part's and each easing stage's step (from the library's fps, at
+    /// the first tick).
+    k_slow: f32,
+    k_gain: f32,
     aim: f32,
 }
 
@@ -62,6 +70,8 @@ impl Expression {
             slow: [0.0; MAX_CHANNELS],
             started: false,
             stages: [1.0; 3],
+            k_slow: 0.0,
+            k_gain: 0.0,
             aim: 1.0,
         }
     }
@@ -83,85 +93,76 @@ impl Expression {
         self.aim
     }
 
+    /// Channel `ch`: its slow part `k` of the way to `out[ch]`, its quick part times `1 + g`
+    /// (the difference wrapped for a group's angle, which may come back a turn away after a
+    /// cut).
+    fn channel(&mut self, out: &mut [f32; MAX_CHANNELS], ch: usize, k: f32, g: f32, wrap: bool) {
+        let d = out[ch] - self.slow[ch];
+        let d = if wrap { wrap_deg(d) } else { d };
+        if !d.is_finite() {
+            self.slow[ch] = out[ch];
+            return;
+        }
+        self.slow[ch] += k * d;
+        let v = out[ch] + g * d;
+        if g != 0.0 && v.is_finite() {
+            out[ch] = v;
+        }
+    }
+
     /// Moves the slow part one tick towards `out[..n]` and scales `out`'s quick part.
+    #[inline(never)]
     pub(super) fn apply<L: LibraryFrames + ?Sized>(
         &mut self,
         lib: &L,
         out: &mut [f32; MAX_CHANNELS],
         n: usize,
     ) {
-        let fps = lib.fps();
-        let fps = if fps.is_finite() && fps > 0.0 {
-            fps
-        } else {
-            1.0
-        };
         if !self.started {
             self.slow[..n].copy_from_slice(&out[..n]);
             self.started = true;
+            let fps = lib.fps();
+            let fps = if fps.is_finite() && fps > 0.0 {
+                fps
+            } else {
+                1.0
+            };
+            self.k_gain = 1.0 - libm::expf(-1.0 / (GAIN_S * fps));
+            self.k_slow = 1.0 - libm::expf(-1.0 / (SLOW_S * fps));
         }
-        let k_gain = 1.0 - libm::expf(-1.0 / (GAIN_S * fps));
+        let (k_gain, k) = (self.k_gain, self.k_slow);
         let mut towards = self.aim;
         for s in self.stages.iter_mut() {
             *s += (towards - *s) * k_gain;
             towards = *s;
         }
-        if self
-            .stages
-            .iter()
-            .all(|s| (s - self.aim).abs() < GAIN_EPSILON)
-            || !self.stages.iter().all(|s| s.is_finite())
-        {
+        // The first stage is the furthest from the aim (they move towards it in turn).
+        let off = (self.stages[0] - self.aim).abs() + (self.stages[2] - self.aim).abs();
+        if !(off >= GAIN_EPSILON) {
             self.stages = [self.aim; 3];
         }
-        let k = 1.0 - libm::expf(-1.0 / (SLOW_S * fps));
         let g = self.stages[2] - 1.0;
-        // The channels of rotation groups, scaled as rotations first.
-        let mut grouped = [0u32; MAX_CHANNELS.div_ceil(32)];
+        // A rotation group's angles are scaled as a single angle's, but less near its gimbal
+        // lock (see the module docs).
+        let mut done = [0u32; MAX_CHANNELS.div_ceil(32)];
         for group in 0..lib.group_count() {
-            let (first, order) = lib.group(group);
+            let (first, _) = lib.group(group);
             if first.saturating_add(3) > n {
                 continue;
             }
+            let b = wrap_deg(out[first + 1]).abs();
+            let b = if b > 90.0 { 180.0 - b } else { b };
+            let w = ((GIMBAL_FADE.1 - b) / (GIMBAL_FADE.1 - GIMBAL_FADE.0)).clamp(0.0, 1.0);
             for ch in first..first + 3 {
-                grouped[ch / 32] |= 1 << (ch % 32);
-            }
-            let o = [order[0] as usize, order[1] as usize, order[2] as usize];
-            let here = [out[first], out[first + 1], out[first + 2]];
-            let before = [self.slow[first], self.slow[first + 1], self.slow[first + 2]];
-            let q = quaternion(&euler_matrix(o, here));
-            let qs = quaternion(&euler_matrix(o, before));
-            let d = quat_log(&quat_mul(&q, &quat_conj(&qs)));
-            let moved = quat_mul(&quat_exp(&d.map(|v| k * v)), &qs);
-            let slow = nearest_euler(euler_angles(&quat_matrix(&moved), o), before, o);
-            let slow = if slow.iter().all(|v| v.is_finite()) {
-                slow
-            } else {
-                here
-            };
-            self.slow[first..first + 3].copy_from_slice(&slow);
-            if g != 0.0 {
-                let r = quat_mul(&quat_exp(&d.map(|v| g * v)), &q);
-                let shown = nearest_euler(euler_angles(&quat_matrix(&r), o), here, o);
-                if shown.iter().all(|v| v.is_finite()) {
-                    out[first..first + 3].copy_from_slice(&shown);
-                }
+                self.channel(out, ch, k, g * w, true);
+                done[ch / 32] |= 1 << (ch % 32);
             }
         }
-        // Single angles.
-        for (ch, o) in out.iter_mut().enumerate().take(n) {
-            if grouped[ch / 32] & (1 << (ch % 32)) != 0 {
-                continue;
-            }
-            let d = wrap_deg(*o - self.slow[ch]);
-            if !d.is_finite() {
-                self.slow[ch] = *o;
-                continue;
-            }
-            self.slow[ch] += k * d;
-            let v = *o + g * d;
-            if g != 0.0 && v.is_finite() {
-                *o = v;
+        // Single angles, in degrees as the player blends them (not wrapped: a servo's 170 and
+        // -170 degrees are far apart).
+        for ch in 0..n {
+            if done[ch / 32] & (1 << (ch % 32)) == 0 {
+                self.channel(out, ch, k, g, false);
             }
         }
     }

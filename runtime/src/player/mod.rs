@@ -526,7 +526,7 @@ impl Player {
 /// Of the two Euler decompositions of one rotation (`(a, b, c)` and
 /// `(a + 180, 180 - b, c + 180)`, wrapped), the one closer to `near`, each angle then moved by
 /// whole turns to lie within 180 degrees of `near`'s.
-pub(crate) fn nearest_euler(angles: [f32; 3], near: [f32; 3], order: [usize; 3]) -> [f32; 3] {
+fn nearest_euler(angles: [f32; 3], near: [f32; 3], order: [usize; 3]) -> [f32; 3] {
     // The second solution's middle angle: 180 - b for cyclic orders (b = asin(+-m)), which is
     // the same rotation because R_i(a + 180) R_j(180 - b) R_k(c + 180) = R_i(a) R_j(b) R_k(c).
     let _ = order;
