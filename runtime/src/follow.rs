@@ -51,6 +51,12 @@
 //!   neutral hand speed; scaled, 0.63). The rest penalty and resting stay the voice's: without
 //!   the penalty every tone brought the rests into speech.
 //!
+//! - **the gesture's size** ([`Expressive`], [`Voice::gain`]): between decisions the player's
+//!   expression stage ([`crate::player::expression`]) shows the quick part of the motion
+//!   larger with a louder syllable, smaller with a quieter one, and at half size from the first
+//!   pause step of a silence, so the motion follows the voice within a syllable, not only at
+//!   the next exit point.
+//!
 //! The belief still chooses among segments of like energy, and the variety costs still apply
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
 //! `f32` on values read from the blob, the same on host and device; the state is a few bytes.

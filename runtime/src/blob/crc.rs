@@ -1,17 +1,20 @@
 //! CRC-32 (IEEE 802.3, the zlib/PNG one): reflected polynomial `0xEDB88320`, initial value and
-//! final XOR `0xFFFFFFFF`. Table-driven; the 1 KiB table is computed at compile time and lives in
-//! flash. No panics, no allocation.
+//! final XOR `0xFFFFFFFF`. Table-driven four bits at a time: the 64-byte table is computed at
+//! compile time and lives in flash (a byte-at-a-time table is 1 KiB of the boards' 96 KiB
+//! of code; the CRC runs only when a blob or show is parsed, where twice the lookups cost
+//! 0.7 M instructions more for the demo's 230 KB blob, 7 ms at 100 MHz). No panics, no
+//! allocation.
 
-/// The byte-at-a-time table, built by a `const fn`.
-const TABLE: [u32; 256] = table();
+/// The nibble-at-a-time table, built by a `const fn`.
+const TABLE: [u32; 16] = table();
 
-const fn table() -> [u32; 256] {
-    let mut t = [0u32; 256];
+const fn table() -> [u32; 16] {
+    let mut t = [0u32; 16];
     let mut i = 0;
-    while i < 256 {
+    while i < 16 {
         let mut c = i as u32;
         let mut k = 0;
-        while k < 8 {
+        while k < 4 {
             c = if c & 1 != 0 {
                 0xEDB8_8320 ^ (c >> 1)
             } else {
@@ -41,7 +44,9 @@ impl Crc32 {
     pub fn update(&mut self, data: &[u8]) {
         let mut c = self.state;
         for &b in data {
-            c = TABLE[((c ^ b as u32) & 0xFF) as usize] ^ (c >> 8);
+            c ^= b as u32;
+            c = TABLE[(c & 0xF) as usize] ^ (c >> 4);
+            c = TABLE[(c & 0xF) as usize] ^ (c >> 4);
         }
         self.state = c;
     }

@@ -111,7 +111,6 @@ impl Expression {
     }
 
     /// Moves the slow part one tick towards `out[..n]` and scales `out`'s quick part.
-    #[inline(never)]
     pub(super) fn apply<L: LibraryFrames + ?Sized>(
         &mut self,
         lib: &L,
@@ -138,7 +137,7 @@ impl Expression {
         }
         // The first stage is the furthest from the aim (they move towards it in turn).
         let off = (self.stages[0] - self.aim).abs() + (self.stages[2] - self.aim).abs();
-        if !(off >= GAIN_EPSILON) {
+        if off < GAIN_EPSILON || !off.is_finite() {
             self.stages = [self.aim; 3];
         }
         let g = self.stages[2] - 1.0;
