@@ -25,7 +25,8 @@
 //! State: one value per channel and the gain; no allocation, no panics; a non-finite result
 //! leaves the channel as the player gave it.
 
-use super::{LibraryFrames, MAX_CHANNELS};
+use super::library::LibraryFrames;
+use crate::rig::MAX_CHANNELS;
 use crate::rotation::wrap_deg;
 
 /// Time constant of the slow part (s): a stroke (a quarter to half a second) is quick, the
