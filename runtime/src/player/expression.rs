@@ -54,6 +54,10 @@ const GAIN_EPSILON: f32 = 1.0e-3;
 pub(super) struct Expression {
     /// The slow part per channel (degrees; a group's three slots hold Euler angles).
     slow: [f32; MAX_CHANNELS],
+    /// The last cut's offset per channel (degrees), and the share of it the player's blend
+    /// added at the last tick: that part of the pose is not scaled.
+    cut: [f32; MAX_CHANNELS],
+    left: f32,
     /// Whether `slow` holds a pose yet.
     started: bool,
     /// The gain's three easing stages; the last is the gain.
@@ -69,6 +73,8 @@ impl Expression {
     pub(super) const fn new() -> Self {
         Self {
             slow: [0.0; MAX_CHANNELS],
+            cut: [0.0; MAX_CHANNELS],
+            left: 0.0,
             started: false,
             stages: [1.0; 3],
             k_slow: 0.0,
@@ -94,12 +100,22 @@ impl Expression {
         self.aim
     }
 
-    /// Channel `ch`: its slow part `k` of the way to `out[ch]`, its quick part times `1 + g`
-    /// (the difference wrapped for a group's angle, which may come back a turn away after a
-    /// cut).
+    /// A cut on channel `ch` whose blend starts from `offset` (the last pose minus the new
+    /// frames, in degrees): the slow part moves by it with the frames, so the quick part goes
+    /// on as it was, and the offset, which the blend closes, is not scaled.
+    pub(super) fn cut(&mut self, ch: usize, offset: f32) {
+        if self.started && offset.is_finite() {
+            self.slow[ch] -= offset - self.left * self.cut[ch];
+            self.cut[ch] = offset;
+        }
+    }
+
+    /// Channel `ch`: its slow part `k` of the way to the frames (`out[ch]` without the
+    /// blend's offset), their quick part times `1 + g` (the difference wrapped for a group's
+    /// angle, which may come back a turn away after a cut).
     fn channel(&mut self, out: &mut [f32; MAX_CHANNELS], ch: usize, k: f32, g: f32, wrap: bool) {
-        let d = out[ch] - self.slow[ch];
-        let d = if wrap { wrap_deg(d) } else { d };
+        let (d, c) = (out[ch] - self.slow[ch], self.left * self.cut[ch]);
+        let d = if wrap { wrap_deg(d) - wrap_deg(c) } else { d - c };
         if !d.is_finite() {
             self.slow[ch] = out[ch];
             return;
@@ -111,13 +127,16 @@ impl Expression {
         }
     }
 
-    /// Moves the slow part one tick towards `out[..n]` and scales `out`'s quick part.
+    /// Moves the slow part one tick towards `out[..n]` and scales `out`'s quick part; `left`
+    /// is the share of the last cut's offset in `out` (the player's blend).
     pub(super) fn apply<L: LibraryFrames + ?Sized>(
         &mut self,
         lib: &L,
         out: &mut [f32; MAX_CHANNELS],
         n: usize,
+        left: f32,
     ) {
+        self.left = left;
         if !self.started {
             self.slow[..n].copy_from_slice(&out[..n]);
             self.started = true;

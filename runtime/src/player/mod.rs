@@ -297,9 +297,6 @@ impl Player {
         self.since = 0;
         self.cut_ticks = self.blend_ticks;
         self.blending = self.blend_ticks > 0 && self.outputs > 0;
-        if !self.blending {
-            return;
-        }
         let n = lib.channels().min(MAX_CHANNELS);
         let moving = self.outputs > 1;
         let next = (f + 1).min(len - 1);
@@ -309,6 +306,10 @@ impl Player {
             let t0 = self.target(lib, c, f, ch);
             let t1 = self.target(lib, c, next, ch);
             let x0 = self.last[ch] - (t0 - (t1 - t0));
+            self.expression.cut(ch, x0);
+            if !self.blending {
+                continue;
+            }
             let src_v = if moving {
                 self.last[ch] - self.prev[ch]
             } else {
@@ -317,6 +318,9 @@ impl Player {
             let v0 = src_v - (t1 - t0);
             self.off[ch] = if x0.is_finite() { x0 } else { 0.0 };
             self.vel[ch] = if v0.is_finite() { v0 } else { 0.0 };
+        }
+        if !self.blending {
+            return;
         }
         // The largest offset (degrees), for the speed cap: scalar channels as they are, a
         // rotation group as its angle.
@@ -449,11 +453,14 @@ impl Player {
         if self.blending && self.since >= self.cut_ticks {
             self.blending = false;
         }
+        // The share of the cut's offset (without its velocity's part) in the pose.
+        let mut left = 0.0;
         if self.blending {
             let a = SETTLE / self.cut_ticks.max(1) as f32;
             // Tick 1 is the first frame of the new segment (the offset is from tick 0).
             let t = (self.since + 1) as f32;
             let decay = libm::expf(-a * t);
+            left = (1.0 + a * t + 0.5 * a * a * t * t) * decay;
             let spring = |x0: f32, v0: f32| {
                 (x0 + (v0 + a * x0) * t + (a * v0 + 0.5 * a * a * x0) * t * t) * decay
             };
@@ -501,7 +508,7 @@ impl Player {
         }
         // `last` is the player's own pose (what the next cut blends from); what is shown has
         // the expression stage on top.
-        self.expression.apply(lib, out, n);
+        self.expression.apply(lib, out, n, left);
         self.outputs = self.outputs.saturating_add(1);
         if advance {
             // Frame counts stay far below 2^24, so the position is exact in f32.
