@@ -41,9 +41,9 @@
 //! faster than a rest should ([`crate::follow::rest_rate`]), and with look-ahead it stretches
 //! or hurries a stroke's approach so the stroke lands on a coming syllable.
 //!
-//! **Expression.** After the blend, [`Player::set_gain`] scales the quick part of the motion
-//! around its slow part (the posture), eased in ([`expression`]): the controller aims it from
-//! the voice. A gain of 1 shows the frames.
+//! **Expression.** After the blend, [`Player::set_gain`] scales the quick part of the frames'
+//! motion around its slow part (the posture), eased in, and leaves a cut's blend as it is
+//! ([`expression`]): the controller aims it from the voice. A gain of 1 shows the frames.
 //!
 //! Invariants: fixed memory (a few arrays of [`MAX_CHANNELS`] values), no allocation, no panics;
 //! every output value is finite (non-finite library values are replaced by the previous

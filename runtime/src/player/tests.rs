@@ -486,3 +486,73 @@ fn the_expression_gain_eases_to_its_aim() {
     p.set_gain(7.0);
     assert_eq!(p.gain_aim(), expression::GAIN_RANGE.1);
 }
+
+/// Two still poses: a single angle and a rotation group about X (`Z, Y, X` order).
+struct Still;
+
+impl LibraryFrames for Still {
+    fn channels(&self) -> usize {
+        4
+    }
+    fn fps(&self) -> f32 {
+        30.0
+    }
+    fn segment_count(&self) -> usize {
+        2
+    }
+    fn segment_len(&self, _: usize) -> usize {
+        60
+    }
+    fn value(&self, c: usize, _: usize, ch: usize) -> f32 {
+        match (c, ch) {
+            (0, 0) => 10.0,
+            (1, 0) => -30.0,
+            (1, 3) => 40.0,
+            _ => 0.0,
+        }
+    }
+    fn group_count(&self) -> usize {
+        1
+    }
+    fn group(&self, _: usize) -> (usize, [u8; 3]) {
+        (1, [2, 1, 0])
+    }
+}
+
+/// A cut's blend is the player's, whatever the gain: between two still poses there is no
+/// quick motion to scale, so a gain of 0.5 or 2 shows the very blend a gain of 1 shows (a
+/// stage that took the blend's offset for quick motion would overshoot the new pose by the
+/// gain's excess, or stop short of it).
+#[test]
+fn a_cuts_blend_is_not_scaled_by_the_gain() {
+    let blend = |gain: f32| {
+        let mut p = Player::new();
+        p.set_blend_ticks(10);
+        p.set_gain(gain);
+        let mut out = [0.0; MAX_CHANNELS];
+        let mut shown = [[0.0f32; 4]; 30];
+        for _ in 0..30 {
+            p.tick(&Still, &mut out);
+        }
+        p.enter(&Still, 1);
+        for pose in shown.iter_mut() {
+            p.tick(&Still, &mut out);
+            pose.copy_from_slice(&out[..4]);
+        }
+        shown
+    };
+    let plain = blend(1.0);
+    // The blend moves (it is not a hard cut) and arrives.
+    assert!(plain[3][0] > -25.0 && plain[3][3] < 35.0, "{:?}", plain[3]);
+    assert!((plain[29][0] + 30.0).abs() < 1e-3 && (plain[29][3] - 40.0).abs() < 1e-3);
+    for gain in [0.5, 2.0] {
+        for (t, (a, b)) in blend(gain).iter().zip(&plain).enumerate() {
+            for ch in 0..4 {
+                assert!(
+                    (a[ch] - b[ch]).abs() < 1e-3,
+                    "gain {gain}, tick {t}: {a:?} vs {b:?}"
+                );
+            }
+        }
+    }
+}
