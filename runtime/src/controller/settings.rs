@@ -48,17 +48,6 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         };
     }
 
-    /// Sets how a gesture's size follows the voice (set by [`set_follow`](Self::set_follow):
-    /// [`Expressive::of`](crate::follow::Expressive::of) the blob's voice following); an evaluation's ablation sets [`Expressive::NONE`](crate::follow::Expressive::NONE).
-    pub fn set_expression(&mut self, e: Expressive) {
-        self.expression = e;
-    }
-
-    /// How a gesture's size follows the voice.
-    pub fn expression(&self) -> Expressive {
-        self.expression
-    }
-
     /// How the character follows the voice.
     pub fn follow(&self) -> VoiceFollow {
         self.follow

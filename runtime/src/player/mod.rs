@@ -460,10 +460,10 @@ impl Player {
             // Tick 1 is the first frame of the new segment (the offset is from tick 0).
             let t = (self.since + 1) as f32;
             let decay = libm::expf(-a * t);
-            left = (1.0 + a * t + 0.5 * a * a * t * t) * decay;
             let spring = |x0: f32, v0: f32| {
                 (x0 + (v0 + a * x0) * t + (a * v0 + 0.5 * a * a * x0) * t * t) * decay
             };
+            left = spring(1.0, 0.0);
             for (ch, o) in out.iter_mut().enumerate().take(n) {
                 *o += spring(self.off[ch], self.vel[ch]);
             }
