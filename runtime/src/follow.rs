@@ -53,9 +53,14 @@
 //!
 //! - **the gesture's size** ([`Expressive`], [`Voice::gain`]): between decisions the player's
 //!   expression stage ([`crate::player::expression`]) shows the quick part of the motion
-//!   larger with a louder syllable, smaller with a quieter one, and at half size from the first
-//!   pause step of a silence, so the motion follows the voice within a syllable, not only at
-//!   the next exit point.
+//!   larger when the voice is louder, smaller when it is quieter, and at half size from the
+//!   first pause step of a silence, so the motion follows the voice within a syllable, not
+//!   only at the next exit point. Live, the loudness is the front-end's 10 ms frames
+//!   ([`Voice::hear`]: a quick rise, a slower fall), not the syllables' levels: a syllable's
+//!   level is known only once the syllable has ended and been confirmed (about 0.09 s later),
+//!   and the hands' speed then trailed the voice by about 0.3 s (their correlation with the
+//!   loudness was highest with the speech moved 0.3 s later). With look-ahead the syllables'
+//!   levels take effect at their own time, and they set the size.
 //!
 //! The belief still chooses among segments of like energy, and the variety costs still apply
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
@@ -85,8 +90,8 @@ impl VoiceFollow {
 
 /// How much a gesture's size follows the voice: the player's expression stage
 /// ([`crate::player::expression`]) shows the quick part of the motion `1 + span * v` times its
-/// size while speaking (`v` the last syllable's level over [`VOICE_SPAN`], clamped to -1..1)
-/// and `pause` times from the first pause step of a silence.
+/// size while speaking (`v` the loudness heard over [`VOICE_SPAN`], clamped to -1..1; see
+/// [`Voice::gain`]) and `pause` times from the first pause step of a silence.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Expressive {
     /// Gain above or below 1 at full voice level (each way).
@@ -148,6 +153,13 @@ pub use crate::policy::REST_EXTRAS;
 /// Voice level (the step feature, 10 dB units) at which the energy weight is full.
 pub const VOICE_SPAN: f32 = 0.5;
 
+/// Per 10 ms frame heard live, how far the loudness a gesture's size follows moves towards a
+/// louder frame (a time constant of 30 ms) and towards a quieter one (120 ms): it rises with a
+/// syllable's onset and falls over the gaps between phrases, not between every two syllables.
+pub const HEAR_ATTACK: f32 = 0.28;
+/// See [`HEAR_ATTACK`].
+pub const HEAR_RELEASE: f32 = 0.08;
+
 /// What just changed in the voice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VoiceChange {
@@ -167,6 +179,10 @@ pub struct Voice {
     level: f32,
     resting: bool,
     change: Option<VoiceChange>,
+    /// The loudness the gesture's size follows (relative to the running level, 10 dB
+    /// units): the frames' ([`Voice::hear`]) once any is heard, else the last syllable's.
+    now: f32,
+    hearing: bool,
 }
 
 impl Voice {
@@ -177,6 +193,8 @@ impl Voice {
             level: 0.0,
             resting: false,
             change: None,
+            now: 0.0,
+            hearing: false,
         }
     }
 
@@ -185,6 +203,9 @@ impl Voice {
         if !pause {
             self.silent_steps = 0;
             self.level = if level.is_finite() { level } else { 0.0 };
+            if !self.hearing {
+                self.now = self.level;
+            }
             return;
         }
         self.silent_steps = self.silent_steps.saturating_add(1);
@@ -201,7 +222,27 @@ impl Voice {
         if self.resting {
             self.resting = false;
             self.level = VOICE_SPAN;
+            if !self.hearing {
+                self.now = VOICE_SPAN;
+            }
             self.change = Some(VoiceChange::Speak);
+        }
+    }
+
+    /// A 10 ms frame of intensity `db` heard live, the speaker's running syllable level
+    /// being `reference_db`: the loudness the gesture's size follows moves towards it
+    /// ([`HEAR_ATTACK`] rising, [`HEAR_RELEASE`] falling).
+    pub fn hear(&mut self, db: f32, reference_db: f32) {
+        // 30 dB under the level is silence enough.
+        let l = ((db - reference_db) / 10.0).clamp(-3.0, 2.0);
+        if l.is_finite() {
+            self.hearing = true;
+            let k = if l > self.now {
+                HEAR_ATTACK
+            } else {
+                HEAR_RELEASE
+            };
+            self.now += k * (l - self.now);
         }
     }
 
@@ -216,15 +257,16 @@ impl Voice {
     }
 
     /// The expression gain the voice asks for now ([`Expressive`]): `e.pause` from the
-    /// first pause step of a silence, else `1 + e.span * clamp(level / VOICE_SPAN, -1, 1)`,
-    /// the span scaled by `share` (the style's neutral share: a tone the user chose sets the
-    /// body's energy); within the player's
-    /// [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not finite.
-    pub fn gain(&self, e: &Expressive, share: f32) -> f32 {
+    /// first pause step of a silence, else `1 + e.span * clamp(level / VOICE_SPAN, -1, 1)`
+    /// (`level` the loudness heard, [`Voice::hear`], or without frames the last syllable's);
+    /// within the player's [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not
+    /// finite. Under every tone alike: a tone chooses which gestures are played and how
+    /// energetic they are, the voice how large they are shown.
+    pub fn gain(&self, e: &Expressive) -> f32 {
         let g = if self.resting || self.silent_steps > 0 {
             e.pause
         } else {
-            1.0 + e.span * share * (self.level / VOICE_SPAN).clamp(-1.0, 1.0)
+            1.0 + e.span * (self.now / VOICE_SPAN).clamp(-1.0, 1.0)
         };
         let (lo, hi) = crate::player::expression::GAIN_RANGE;
         if g.is_finite() {
@@ -324,6 +366,44 @@ mod tests {
         rest_cost: 4.0,
         energy_cost: 2.0,
     };
+
+    /// Known answer: heard live, the loudness the size follows rises by `HEAR_ATTACK` and
+    /// falls by `HEAR_RELEASE` of the way per frame (`1 - (1 - k)^n` after `n` frames), in
+    /// level units relative to the speaker's running level, bounded to -3..2; a syllable's
+    /// level no longer sets it, and a non-finite frame leaves it.
+    #[test]
+    fn heard_frames_set_the_gain_with_a_quick_rise_and_a_slow_fall() {
+        let e = EXPRESSION;
+        let mut v = Voice::new();
+        // Before any frame is heard (look-ahead), the last syllable's level sets the gain.
+        v.step(&F, false, 0.25, 250);
+        assert!((v.gain(&e) - (1.0 + e.span * 0.5)).abs() < 1e-6);
+        // 5 dB above the level (0.5 units) for 4 frames: the rise from 0.25.
+        for _ in 0..4 {
+            v.hear(65.0, 60.0);
+        }
+        let now = 0.5 - 0.25 * (1.0 - HEAR_ATTACK).powi(4);
+        let want = 1.0 + e.span * (now / VOICE_SPAN);
+        assert!((v.gain(&e) - want).abs() < 1e-5, "{}", v.gain(&e));
+        // A syllable's level, reported a syllable late, does not override what is heard.
+        v.step(&F, false, -0.5, 250);
+        assert!((v.gain(&e) - want).abs() < 1e-5);
+        // Silence (-300 dB counts as 30 dB under the level) for 10 frames: the slow fall.
+        for _ in 0..10 {
+            v.hear(-300.0, 60.0);
+        }
+        let fall = -3.0 + (now + 3.0) * (1.0 - HEAR_RELEASE).powi(10);
+        let want = 1.0 + e.span * (fall / VOICE_SPAN).clamp(-1.0, 1.0);
+        assert!((v.gain(&e) - want).abs() < 1e-5, "{}", v.gain(&e));
+        assert!(fall < -0.5 && fall > -3.0);
+        let g = v.gain(&e);
+        v.hear(f32::NAN, 60.0);
+        v.hear(70.0, f32::INFINITY);
+        assert_eq!(v.gain(&e), g);
+        // A pause step still brings the pause's gain.
+        v.step(&F, true, -3.0, 250);
+        assert_eq!(v.gain(&e), e.pause);
+    }
 
     #[test]
     fn rest_begins_after_rest_ms_of_pause_steps_and_ends_at_an_onset() {

@@ -203,6 +203,11 @@ impl Ahead {
         self.slew = RATE_SLEW_PER_S * 1000.0 / fps_milli.max(1) as f32;
     }
 
+    /// Whether the audio is played as it is heard (no look-ahead).
+    pub(super) fn live(&self) -> bool {
+        self.lead_samples == 0
+    }
+
     /// An onset at 10 ms frame `frame` reported while tick `now` is due next: returns whether
     /// it counts for decisions now and whether the voice hears it now (else it is queued).
     pub(super) fn onset(&mut self, frame: u32, now: u64, fps_milli: u64) -> (bool, bool) {

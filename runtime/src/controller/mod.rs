@@ -314,7 +314,15 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         let (voice, follow, pause_ms) = (&mut self.voice, &self.follow, self.pause_ms);
         let (ahead, fps_milli) = (&mut self.ahead, self.fps_milli);
         let mut on_event = |ev| match ev {
-            Event::Frame(f) => sink(ControllerEvent::Frame(f)),
+            Event::Frame(f) => {
+                // Live, the size of the gestures follows the loudness frame by frame (a
+                // syllable's own level comes a syllable late); with look-ahead the syllables'
+                // levels take effect at their own time.
+                if ahead.live() {
+                    voice.hear(f.intensity_db, normalizer.reference_db());
+                }
+                sink(ControllerEvent::Frame(f))
+            }
             Event::Onset(frame) => {
                 let (sync, hear) = ahead.onset(frame, now, fps_milli);
                 if sync {
@@ -398,7 +406,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
                 command,
             });
         }
-        let gain = self.voice.gain(&self.expression, self.style.neutral());
+        let gain = self.voice.gain(&self.expression);
         if gain != self.player.gain_aim() {
             self.player.set_gain(gain);
             sink(ControllerEvent::Play {

@@ -89,6 +89,13 @@ impl StepNormalizer {
     }
 }
 
+impl StepNormalizer {
+    /// The speaker's running syllable intensity (dB).
+    pub fn reference_db(&self) -> f32 {
+        self.ref_db
+    }
+}
+
 impl Default for StepNormalizer {
     fn default() -> Self {
         Self::new()

@@ -457,6 +457,49 @@ fn the_expression_gain_scales_the_quick_part_around_the_posture() {
     }
 }
 
+/// A change of gain changes the quick part's speed at once and its size over
+/// [`expression::RELAX_S`]: aimed from 1 to 2 at a crest of the sine (where the frames hardly
+/// move), over its first three ticks the shown pose steps less than half as far as `slow + gain x quick` shown
+/// directly would (which pushes the hands out by the change of gain times the quick part), and
+/// three seconds later it is that form again (a float reference of the slow part).
+#[test]
+fn a_change_of_gain_does_not_push_the_pose() {
+    let k = 1.0 - (-1.0 / (expression::SLOW_S as f64 * 30.0)).exp();
+    let mut p = Player::new();
+    let mut out = [0.0; MAX_CHANNELS];
+    let (mut slow, mut last, mut last_direct) = ([0.0f64; 2], [0.0f64; 2], [0.0f64; 2]);
+    let (mut step, mut step_direct) = (0.0f64, 0.0f64);
+    // Tick 307 is 7 frames into a cycle: the crest of the sine.
+    for n in 0..400usize {
+        if n == 307 {
+            p.set_gain(2.0);
+        }
+        p.tick(&Sine, &mut out);
+        for (i, ch) in [0usize, 1].into_iter().enumerate() {
+            let x = Sine.value(0, n, ch) as f64;
+            let d = if n == 0 { 0.0 } else { x - slow[i] };
+            slow[i] = if n == 0 { x } else { slow[i] + k * d };
+            let direct = x + (p.gain() as f64 - 1.0) * d;
+            let shown = out[ch] as f64;
+            if (307..310).contains(&n) {
+                step = step.max((shown - last[i]).abs());
+                step_direct = step_direct.max((direct - last_direct[i]).abs());
+            }
+            if !(307..397).contains(&n) {
+                assert!(
+                    (shown - direct).abs() < 1e-3,
+                    "tick {n} ch {ch}: {shown} vs {direct}"
+                );
+            }
+            (last[i], last_direct[i]) = (shown, direct);
+        }
+    }
+    assert!(
+        step < 0.5 * step_direct && step_direct > 3.0,
+        "largest step {step} vs {step_direct}"
+    );
+}
+
 /// The gain eases to its aim through three first-order stages: it first moves by `k^3` of
 /// the change (`k = 1 - e^(-1 / (GAIN_S fps))`), then monotonically, and is there (within
 /// the snap of 0.001) in two thirds of a second; a non-finite aim is ignored and aims are

@@ -122,8 +122,7 @@ impl Timeline {
             }
             resting.push(voice.resting());
             weight.push(voice.weight(&follow));
-            // The plan is for the neutral style.
-            gain.push(voice.gain(&expression, 1.0));
+            gain.push(voice.gain(&expression));
             belief_at.push(step);
         }
         let mut beliefs: Vec<Vec<f32>> = steps.into_iter().map(|(_, b)| b).collect();
