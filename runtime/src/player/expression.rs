@@ -20,7 +20,7 @@
 //!   `dgain x quick` and relaxes towards none with time constant [`RELAX_S`]; the shown pose
 //!   is `slow + gain x quick + lag`. While the gain holds, the lag is gone and the pose is
 //!   `slow + gain x quick` exactly; as it changes, the quick part's motion is shown at the new
-//!   gain at once and its reach follows. (A tenth of a second of relaxation brought the push
+//!   gain at once and its reach follows. (Relaxing over 0.15 s brought part of the push
 //!   back: on tuning speech the jerk rose 3 % and the mean step at cuts with it, for
 //!   +0.005 speech coupling.)
 //! - Every channel is scaled in degrees, as the player blends single angles. A rotation
