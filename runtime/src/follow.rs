@@ -60,7 +60,9 @@
 //!   level is known only once the syllable has ended and been confirmed (about 0.09 s later),
 //!   and the hands' speed then trailed the voice by about 0.3 s (their correlation with the
 //!   loudness was highest with the speech moved 0.3 s later). With look-ahead the syllables'
-//!   levels take effect at their own time, and they set the size.
+//!   levels take effect at their own time, and they set the size. The size follows the voice
+//!   under every tone: scaled by the style's neutral weight like the energy weight, an
+//!   `active` tone lost it and moved no faster than neutral speech (0.99x on new speech).
 //!
 //! The belief still chooses among segments of like energy, and the variety costs still apply
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
