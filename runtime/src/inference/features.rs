@@ -87,9 +87,7 @@ impl StepNormalizer {
             pause,
         }
     }
-}
 
-impl StepNormalizer {
     /// The speaker's running syllable intensity (dB).
     pub fn reference_db(&self) -> f32 {
         self.ref_db

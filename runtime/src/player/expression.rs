@@ -146,8 +146,9 @@ impl Expression {
     }
 
     /// Channel `ch`: its slow part `k` of the way to the frames (`out[ch]` without the
-    /// blend's offset), their quick part times `1 + g` (the difference wrapped for a group's
-    /// angle, which may come back a turn away after a cut).
+    /// blend's offset), their quick part (the difference wrapped for a group's angle, which
+    /// may come back a turn away after a cut) shown at the gain, with the gain's excess and
+    /// its change this tick weighted by `w` (the gimbal fade), plus the channel's lag.
     fn channel(&mut self, out: &mut [f32; MAX_CHANNELS], ch: usize, k: f32, w: f32, wrap: bool) {
         let (g, dg) = (self.stages[2] - 1.0, self.stages[2] - self.before);
         let (g, dg) = (g * w, dg * w);

@@ -459,9 +459,10 @@ fn the_expression_gain_scales_the_quick_part_around_the_posture() {
 
 /// A change of gain changes the quick part's speed at once and its size over
 /// [`expression::RELAX_S`]: aimed from 1 to 2 at a crest of the sine (where the frames hardly
-/// move), over its first three ticks the shown pose steps less than half as far as `slow + gain x quick` shown
-/// directly would (which pushes the hands out by the change of gain times the quick part), and
-/// three seconds later it is that form again (a float reference of the slow part).
+/// move), over its first three ticks the shown pose steps less than half as far as
+/// `slow + gain x quick` shown directly would (which pushes the hands out by the change of
+/// gain times the quick part), and three seconds later it is that form again (a float
+/// reference of the slow part).
 #[test]
 fn a_change_of_gain_does_not_push_the_pose() {
     let k = 1.0 - (-1.0 / (expression::SLOW_S as f64 * 30.0)).exp();
