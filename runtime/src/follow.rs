@@ -55,7 +55,9 @@
 //!   expression stage ([`crate::player::expression`]) shows the quick part of the motion
 //!   larger when the voice is louder, smaller when it is quieter, and at half size from the
 //!   first pause step of a silence, so the motion follows the voice within a syllable, not
-//!   only at the next exit point. Live, the loudness is the front-end's 10 ms frames
+//!   only at the next exit point. Resting, a gesture still playing (its cut into a rest waits
+//!   for a pause of its hands, a second or more at the rest's pace) is shown at a quarter of
+//!   its size ([`Expressive::caught`]): it settled sooner on every span measured. Live, the loudness is the front-end's 10 ms frames
 //!   ([`Voice::hear`]: a quick rise, a slower fall), not the syllables' levels: a syllable's
 //!   level is known only once the syllable has ended and been confirmed (about 0.09 s later),
 //!   and the hands' speed then trailed the voice by about 0.3 s (their correlation with the
@@ -100,6 +102,9 @@ pub struct Expressive {
     pub span: f32,
     /// Gain in a silence.
     pub pause: f32,
+    /// Gain of a gesture still playing once the character rests (until the cut into a rest
+    /// segment, which waits for a pause of the hands).
+    pub caught: f32,
 }
 
 impl Expressive {
@@ -107,6 +112,7 @@ impl Expressive {
     pub const NONE: Self = Self {
         span: 0.0,
         pause: 1.0,
+        caught: 1.0,
     };
 
     /// The expression of a blob that follows the voice as `follow` says: [`EXPRESSION`], or
@@ -121,12 +127,14 @@ impl Expressive {
 }
 
 /// The expression of a blob that follows the voice: 30 % larger at full voice level (5 dB
-/// above the speaker's running level), 30 % smaller at the other end, half size in a silence.
-/// A third either way stays within how much one speaker's strokes vary in size between calm
-/// and emphatic phrases; chosen on tuning speech (docs/method.md).
+/// above the speaker's running level), 30 % smaller at the other end, half size in a silence,
+/// and half that for a gesture the rest caught in the middle. A third either way stays within
+/// how much one speaker's strokes vary in size between calm and emphatic phrases; chosen on
+/// tuning speech (docs/method.md).
 pub const EXPRESSION: Expressive = Expressive {
     span: 0.3,
     pause: 0.5,
+    caught: 0.25,
 };
 
 /// How fast a rest moves at most: this share of the library's median hand speed (a segment's
@@ -258,14 +266,18 @@ impl Voice {
         self.change.take()
     }
 
-    /// The expression gain the voice asks for now ([`Expressive`]): `e.pause` from the
-    /// first pause step of a silence, else `1 + e.span * clamp(level / VOICE_SPAN, -1, 1)`
-    /// (`level` the loudness heard, [`Voice::hear`], or without frames the last syllable's);
-    /// within the player's [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not
-    /// finite. Under every tone alike: a tone chooses which gestures are played and how
-    /// energetic they are, the voice how large they are shown.
-    pub fn gain(&self, e: &Expressive) -> f32 {
-        let g = if self.resting || self.silent_steps > 0 {
+    /// The expression gain the voice asks for now ([`Expressive`]), `rest_plays` whether a
+    /// rest segment is playing: resting, `e.caught` while a gesture still plays (the cut into
+    /// a rest waits for a pause of its hands), `e.pause` once a rest plays and from the first
+    /// pause step of a silence; else `1 + e.span * clamp(level / VOICE_SPAN, -1, 1)` (`level`
+    /// the loudness heard, [`Voice::hear`], or without frames the last syllable's); within the
+    /// player's [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not finite. Under
+    /// every tone alike: a tone chooses which gestures are played and how energetic they are,
+    /// the voice how large they are shown.
+    pub fn gain(&self, e: &Expressive, rest_plays: bool) -> f32 {
+        let g = if self.resting && !rest_plays {
+            e.caught
+        } else if self.resting || self.silent_steps > 0 {
             e.pause
         } else {
             1.0 + e.span * (self.now / VOICE_SPAN).clamp(-1.0, 1.0)
@@ -379,47 +391,61 @@ mod tests {
         let mut v = Voice::new();
         // Before any frame is heard (look-ahead), the last syllable's level sets the gain.
         v.step(&F, false, 0.25, 250);
-        assert!((v.gain(&e) - (1.0 + e.span * 0.5)).abs() < 1e-6);
+        assert!((v.gain(&e, false) - (1.0 + e.span * 0.5)).abs() < 1e-6);
         // 5 dB above the level (0.5 units) for 4 frames: the rise from 0.25.
         for _ in 0..4 {
             v.hear(65.0, 60.0);
         }
         let now = 0.5 - 0.25 * (1.0 - HEAR_ATTACK).powi(4);
         let want = 1.0 + e.span * (now / VOICE_SPAN);
-        assert!((v.gain(&e) - want).abs() < 1e-5, "{}", v.gain(&e));
+        assert!(
+            (v.gain(&e, false) - want).abs() < 1e-5,
+            "{}",
+            v.gain(&e, false)
+        );
         // A syllable's level, reported a syllable late, does not override what is heard.
         v.step(&F, false, -0.5, 250);
-        assert!((v.gain(&e) - want).abs() < 1e-5);
+        assert!((v.gain(&e, false) - want).abs() < 1e-5);
         // Silence (-300 dB counts as 30 dB under the level) for 10 frames: the slow fall.
         for _ in 0..10 {
             v.hear(-300.0, 60.0);
         }
         let fall = -3.0 + (now + 3.0) * (1.0 - HEAR_RELEASE).powi(10);
         let want = 1.0 + e.span * (fall / VOICE_SPAN).clamp(-1.0, 1.0);
-        assert!((v.gain(&e) - want).abs() < 1e-5, "{}", v.gain(&e));
+        assert!(
+            (v.gain(&e, false) - want).abs() < 1e-5,
+            "{}",
+            v.gain(&e, false)
+        );
         assert!(fall < -0.5 && fall > -3.0);
-        let g = v.gain(&e);
+        let g = v.gain(&e, false);
         v.hear(f32::NAN, 60.0);
         v.hear(70.0, f32::INFINITY);
-        assert_eq!(v.gain(&e), g);
+        assert_eq!(v.gain(&e, false), g);
         // A pause step still brings the pause's gain.
         v.step(&F, true, -3.0, 250);
-        assert_eq!(v.gain(&e), e.pause);
+        assert_eq!(v.gain(&e, false), e.pause);
     }
 
     #[test]
     fn rest_begins_after_rest_ms_of_pause_steps_and_ends_at_an_onset() {
+        let e = EXPRESSION;
         let mut v = Voice::new();
         v.step(&F, false, 0.3, 250);
         assert_eq!(v.weight(&F), -2.0 * 0.6);
         v.step(&F, true, -6.0, 250);
         assert!(!v.resting());
         assert_eq!(v.take_change(), None);
+        // A silence not yet a rest: the pause's gain, whatever plays.
+        assert_eq!((v.gain(&e, false), v.gain(&e, true)), (e.pause, e.pause));
         v.step(&F, true, -6.0, 250);
         assert!(v.resting());
         assert_eq!(v.take_change(), Some(VoiceChange::Rest));
         assert_eq!(v.take_change(), None);
         assert_eq!(v.weight(&F), 4.0);
+        // Resting: a gesture still playing shrinks further until a rest segment plays.
+        assert_eq!((v.gain(&e, false), v.gain(&e, true)), (e.caught, e.pause));
+        assert!(e.caught < e.pause);
         // More silence changes nothing.
         v.step(&F, true, -6.0, 250);
         assert_eq!(v.take_change(), None);
@@ -430,6 +456,9 @@ mod tests {
         assert_eq!(v.weight(&F), -2.0);
         v.step(&F, false, -0.25, 250);
         assert_eq!(v.weight(&F), 1.0);
+        // Speaking again, the voice's gain, whatever plays.
+        let g = 1.0 + e.span * (-0.25 / VOICE_SPAN);
+        assert!((v.gain(&e, false) - g).abs() < 1e-6 && v.gain(&e, true) == v.gain(&e, false));
     }
 
     #[test]

@@ -277,10 +277,29 @@ fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
         "shrunk at tick {}: {aims:?}",
         shrink.0
     );
-    // Held through the silence; back within the span on the speech's first onset.
-    assert!(!aims
+    // Through the silence: resting (from 0.5 s), a quarter while a gesture still plays (its
+    // cut into a rest waits for a pause of the hands), half once a rest segment plays.
+    let silent: Vec<(usize, f32)> = aims
         .iter()
-        .any(|&(i, _)| (shrink.0 + 1..at(6.9)).contains(&i)));
+        .copied()
+        .filter(|&(i, _)| (shrink.0 + 1..at(6.9)).contains(&i))
+        .collect();
+    for &(i, g) in &silent {
+        let want = if rest(ticks[i].segment) {
+            EXPRESSION.pause
+        } else {
+            EXPRESSION.caught
+        };
+        assert_eq!(g, want, "gain at tick {i}: {:?}", ticks[i]);
+    }
+    assert!(rest(ticks[at(6.8)].segment));
+    assert_eq!(silent.last().map_or(shrink.1, |a| a.1), EXPRESSION.pause);
+    // Here the rest caught a gesture: both were aimed.
+    assert!(
+        silent.iter().any(|a| a.1 == EXPRESSION.caught),
+        "{silent:?}"
+    );
+    // Back within the span on the speech's first onset.
     let back = (at(6.9)..ticks.len()).find(|&i| ticks[i].onset).unwrap();
     let grown = aims.iter().find(|&&(i, _)| i >= at(6.9)).copied().unwrap();
     assert!(

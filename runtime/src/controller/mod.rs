@@ -406,7 +406,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
                 command,
             });
         }
-        let gain = self.voice.gain(&self.expression);
+        let gain = self
+            .voice
+            .gain(&self.expression, self.rest.contains(segment));
         if gain != self.player.gain_aim() {
             self.player.set_gain(gain);
             sink(ControllerEvent::Play {

@@ -22,7 +22,7 @@ pub mod timeline;
 pub use error::BakeError;
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::follow::rest_rate;
+use gesture_runtime::follow::{rest_rate, RestSet};
 use gesture_runtime::player::{
     library_speed_cap, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
 };
@@ -145,15 +145,17 @@ fn shares(plan: &[Planned], ticks: u64, segments: usize) -> Vec<f32> {
 /// The player's commands that carry out `plan` over `ticks` ticks: each decision's after the
 /// pose of its tick; a rest played to and fro (turned at its last frame; the player turns
 /// forward at its first by itself) until the speech returns; the expression gain the voice
-/// asks for at each tick (`gain`, as the live controller aims it), before its pose.
+/// asks for at each tick (`gain`, as the live controller aims it: the first with a rest
+/// segment playing, the second with a gesture), before its pose.
 fn commands(
     blob: &Blob<'_>,
     plan: &[Planned],
     ticks: u64,
-    gain: &[f32],
+    gain: &[(f32, f32)],
 ) -> Vec<(u64, PlayerCommand)> {
     let mut out: Vec<(u64, PlayerCommand)> = Vec::new();
     let mut player = Player::new();
+    let rest = RestSet::of(blob, LibraryFrames::segment_count(blob));
     let fps_milli = (blob.fps() * 1000.0).round() as u64;
     let blend = (blob.blend_ms() as u64 * fps_milli).div_ceil(1_000_000);
     player.set_blend_ticks(blend.min(u32::MAX as u64) as u32);
@@ -163,7 +165,12 @@ fn commands(
     let mut rate = 1.0f32;
     let mut rest_until = 0u64;
     for k in 0..ticks {
-        if let Some(&g) = gain.get(k as usize) {
+        if let Some(&(at_rest, in_gesture)) = gain.get(k as usize) {
+            let g = if rest.contains(player.segment()) {
+                at_rest
+            } else {
+                in_gesture
+            };
             if g != player.gain_aim() {
                 out.push((k, PlayerCommand::Gain(g)));
             }

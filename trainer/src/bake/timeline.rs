@@ -29,8 +29,9 @@ pub struct Timeline {
     pub resting: Vec<bool>,
     /// Per tick: the voice's energy weight of a decision (`follow::Voice::weight`).
     pub weight: Vec<f32>,
-    /// Per tick: the expression gain the voice asks for (`follow::Voice::gain`).
-    pub gain: Vec<f32>,
+    /// Per tick: the expression gain the voice asks for (`follow::Voice::gain`), with a rest
+    /// segment playing and (the second) with a gesture playing.
+    pub gain: Vec<(f32, f32)>,
     /// Per tick: index into `beliefs` of the step spoken then.
     pub belief_at: Vec<usize>,
     /// The belief after each step (at least one: the uniform belief when there is no step).
@@ -122,7 +123,10 @@ impl Timeline {
             }
             resting.push(voice.resting());
             weight.push(voice.weight(&follow));
-            gain.push(voice.gain(&expression));
+            gain.push((
+                voice.gain(&expression, true),
+                voice.gain(&expression, false),
+            ));
             belief_at.push(step);
         }
         let mut beliefs: Vec<Vec<f32>> = steps.into_iter().map(|(_, b)| b).collect();
