@@ -28,6 +28,15 @@ esac
 board=$1
 elf=target/$target/release/qemu-firmware
 
+# Panic locations carry source paths (the runtime's and a few of its dependencies'): the
+# checkout and Cargo's home are remapped to fixed names, so the code size does not depend on
+# where they are (it did by up to a hundred bytes per character of path). Cargo adds these
+# flags to .cargo/config.toml's for the target.
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+cargo_home="${CARGO_HOME:-$HOME/.cargo}"
+flags_var="CARGO_TARGET_$(tr 'a-z.-' 'A-Z__' <<<"$target")_RUSTFLAGS"
+export "$flags_var=--remap-path-prefix=$root=/gesture --remap-path-prefix=$cargo_home=/cargo"
+
 qemu() {
   timeout 300 qemu-system-arm -machine "$machine" -cpu "$cpu" -nographic -monitor none \
     -serial none -semihosting-config enable=on,target=native -icount shift=0 -kernel "$1"
