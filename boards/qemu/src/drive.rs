@@ -299,11 +299,17 @@ pub fn run_with<A: Arith>(
         Device::new(controller, [RecordingPin::default(); CHANNELS]).map_err(RunError::Device)?;
     probe.ready();
 
-    // (`{}` of a `str` would link the padding code into the firmware.)
-    out.write_str("input ")
-        .and_then(|()| out.write_str(name))
-        .and_then(|()| writeln!(out, " samples={}", audio.len() / 2))
-        .map_err(|_| RunError::Output)?;
+    write_parts(
+        out,
+        &[
+            Part::Text("input "),
+            Part::Text(name),
+            Part::Text(" samples="),
+            Part::Dec((audio.len() / 2) as u64),
+            Part::Text("\n"),
+        ],
+    )
+    .map_err(|_| RunError::Output)?;
     let mut sum = Summary {
         belief_hash: FNV_OFFSET,
         pose_hash: FNV_OFFSET,
@@ -363,18 +369,23 @@ pub fn run_with<A: Arith>(
                 }
                 ControllerEvent::Decision { tick, decision } => {
                     sum.decisions += 1;
-                    let written = match decision.choice {
-                        Choice::Continue => writeln!(
+                    let head = [
+                        Part::Text("decision tick="),
+                        Part::Dec(tick),
+                        Part::Text(" exit="),
+                        Part::Dec(decision.exit as u64),
+                    ];
+                    let written = write_parts(out, &head).and_then(|()| match decision.choice {
+                        Choice::Continue => out.write_str(" choice=continue\n"),
+                        Choice::Enter(c) => write_parts(
                             out,
-                            "decision tick={tick} exit={} choice=continue",
-                            decision.exit
+                            &[
+                                Part::Text(" choice=segment "),
+                                Part::Dec(c as u64),
+                                Part::Text("\n"),
+                            ],
                         ),
-                        Choice::Enter(c) => writeln!(
-                            out,
-                            "decision tick={tick} exit={} choice=segment {c}",
-                            decision.exit
-                        ),
-                    };
+                    });
                     if written.is_err() && failure.is_none() {
                         failure = Some(RunError::Output);
                     }
@@ -395,20 +406,74 @@ pub fn run_with<A: Arith>(
             return Err(e);
         }
     }
-    writeln!(
+    write_parts(
         out,
-        "end samples={} frames={} steps={} decisions={} ticks={} belief_hash={:08x} \
-         pose_hash={:08x} duty={}..{}",
-        sum.samples,
-        sum.frames,
-        sum.steps,
-        sum.decisions,
-        sum.ticks,
-        sum.belief_hash,
-        sum.pose_hash,
-        sum.duty_range.0,
-        sum.duty_range.1
+        &[
+            Part::Text("end samples="),
+            Part::Dec(sum.samples),
+            Part::Text(" frames="),
+            Part::Dec(sum.frames),
+            Part::Text(" steps="),
+            Part::Dec(sum.steps),
+            Part::Text(" decisions="),
+            Part::Dec(sum.decisions),
+            Part::Text(" ticks="),
+            Part::Dec(sum.ticks),
+            Part::Text(" belief_hash="),
+            Part::Hex8(sum.belief_hash),
+            Part::Text(" pose_hash="),
+            Part::Hex8(sum.pose_hash),
+            Part::Text(" duty="),
+            Part::Dec(sum.duty_range.0 as u64),
+            Part::Text(".."),
+            Part::Dec(sum.duty_range.1 as u64),
+            Part::Text("\n"),
+        ],
     )
     .map_err(|_| RunError::Output)?;
     Ok(sum)
+}
+
+/// Writes `parts` in order: text as it is, numbers in decimal or as eight hex digits. The
+/// trace's only formatting: core's integer `Display` links its padding code (about 2.5 KB of
+/// the firmware's flash), and `{}` of a `str` the same.
+pub fn write_parts(out: &mut impl Write, parts: &[Part<'_>]) -> fmt::Result {
+    for part in parts {
+        match *part {
+            Part::Text(t) => out.write_str(t)?,
+            Part::Dec(v) => {
+                let mut digits = [0u8; 20];
+                let (mut i, mut v) = (digits.len(), v);
+                loop {
+                    i -= 1;
+                    digits[i] = b'0' + (v % 10) as u8;
+                    v /= 10;
+                    if v == 0 {
+                        break;
+                    }
+                }
+                for &d in &digits[i..] {
+                    out.write_char(d as char)?;
+                }
+            }
+            Part::Hex8(v) => {
+                for k in (0..8).rev() {
+                    let d = ((v >> (4 * k)) & 0xf) as u8;
+                    out.write_char(if d < 10 { b'0' + d } else { b'a' + d - 10 } as char)?;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A piece of a trace line ([`write_parts`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Part<'a> {
+    /// Text as it is.
+    Text(&'a str),
+    /// A number in decimal.
+    Dec(u64),
+    /// A number as eight lowercase hex digits.
+    Hex8(u32),
 }

@@ -36,6 +36,7 @@ use core::fmt::{self, Write};
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hio};
+use drive::Part;
 
 /// The policy blob (`assets/policy.blob`).
 static BLOB: &[u8] = include_bytes!(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/policy.blob"));
@@ -233,14 +234,23 @@ fn main() -> ! {
     let build_stack = stack.build;
     #[cfg(feature = "measure")]
     let build_stack = 0;
-    let _ = writeln!(
-        err,
-        "memory peak_stack_bytes={} build_stack_bytes={build_stack} run_stack_bytes={run_stack} \
-         device_bytes={} blob_bytes={}",
-        build_stack.max(run_stack),
-        core::mem::size_of::<drive::BoardDevice<'static, 'static>>()
-            + core::mem::size_of::<gesture_runtime::controller::BlobController<'static>>(),
-        BLOB.len()
+    let device = core::mem::size_of::<drive::BoardDevice<'static, 'static>>()
+        + core::mem::size_of::<gesture_runtime::controller::BlobController<'static>>();
+    let _ = drive::write_parts(
+        &mut err,
+        &[
+            Part::Text("memory peak_stack_bytes="),
+            Part::Dec(build_stack.max(run_stack) as u64),
+            Part::Text(" build_stack_bytes="),
+            Part::Dec(build_stack as u64),
+            Part::Text(" run_stack_bytes="),
+            Part::Dec(run_stack as u64),
+            Part::Text(" device_bytes="),
+            Part::Dec(device as u64),
+            Part::Text(" blob_bytes="),
+            Part::Dec(BLOB.len() as u64),
+            Part::Text("\n"),
+        ],
     );
     exit(ok)
 }
@@ -253,8 +263,13 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     // has no panic to explain.
     let _ = err.write_str("panic at ");
     if let Some(at) = info.location() {
+        let line = [
+            Part::Text(":"),
+            Part::Dec(at.line() as u64),
+            Part::Text("\n"),
+        ];
         let _ = err.write_str(at.file());
-        let _ = writeln!(err, ":{}", at.line());
+        let _ = drive::write_parts(&mut err, &line);
     }
     exit(false)
 }
@@ -262,13 +277,24 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
 #[exception]
 unsafe fn HardFault(frame: &ExceptionFrame) -> ! {
     let mut err = HostLines::new(hio::hstderr());
-    let _ = writeln!(err, "hard fault at pc={:#010x}", frame.pc());
+    let pc = [
+        Part::Text("hard fault at pc=0x"),
+        Part::Hex8(frame.pc()),
+        Part::Text("\n"),
+    ];
+    let _ = drive::write_parts(&mut err, &pc);
     exit(false)
 }
 
 #[exception]
 unsafe fn DefaultHandler(irqn: i16) {
     let mut err = HostLines::new(hio::hstderr());
-    let _ = writeln!(err, "unexpected exception {irqn}");
+    let irq = [
+        Part::Text("unexpected exception "),
+        Part::Text(if irqn < 0 { "-" } else { "" }),
+        Part::Dec(irqn.unsigned_abs() as u64),
+        Part::Text("\n"),
+    ];
+    let _ = drive::write_parts(&mut err, &irq);
     exit(false)
 }

@@ -26,10 +26,14 @@
 //! - Every channel is scaled in degrees, as the player blends single angles. A rotation
 //!   group's three Euler angles (which the player keeps continuous) are scaled alike: for a
 //!   quick part of a few tens of degrees away from the group's gimbal lock that is the
-//!   rotation scaled. Near the lock (the middle angle within [`GIMBAL_FADE`] of +-90 degrees) a
+//!   rotation scaled. Near the lock (the middle angle [`GIMBAL_FADE`] from 0 or 180 degrees) a
 //!   small rotation swings the outer two angles far and in opposite ways, so the gain fades to
-//!   none there. Scaling the rotation vector itself (quaternions) was built first: the same
-//!   motion, but 3.4 KB more code on the boards, past the 96 KiB budget.
+//!   none there; it fades too where the group's quick part is larger than a gesture's
+//!   ([`QUICK_FADE`]), and past that the angles swung between two Euler forms of about one
+//!   rotation (as Bandai Namco's spine does near its lock): an average across the swing is no
+//!   posture, so the group's slow part starts again from the frames. Scaling the rotation
+//!   vector itself (quaternions) was built first: the same motion, but 3.4 KB more code on the
+//!   boards, past the 96 KiB budget.
 //!
 //! - A cut's blend is not quick motion and is not scaled. The stage comes after the player's
 //!   blend and rate; at a cut the slow part moves by the blend's offset with the frames
@@ -70,7 +74,11 @@ pub const GAIN_RANGE: (f32, f32) = (0.0, 2.0);
 
 /// A rotation group's middle angle (degrees from its nearest 0 or 180) up to which the gain
 /// applies in full, and from which it does not apply (faded linearly between).
-pub const GIMBAL_FADE: (f32, f32) = (60.0, 80.0);
+pub const GIMBAL_FADE: (f32, f32) = (45.0, 70.0);
+
+/// A rotation group's quick part (degrees, its largest angle) up to which the gain applies in
+/// full, and from which it does not apply (faded linearly between).
+pub const QUICK_FADE: (f32, f32) = (60.0, 90.0);
 
 /// A gain this close to its aim is at its aim (so a steady gain of 1 shows the frames).
 const GAIN_EPSILON: f32 = 1.0e-3;
@@ -145,19 +153,13 @@ impl Expression {
         }
     }
 
-    /// Channel `ch`: its slow part `k` of the way to the frames (`out[ch]` without the
-    /// blend's offset), their quick part (the difference wrapped for a group's angle, which
-    /// may come back a turn away after a cut) shown at the gain, with the gain's excess and
-    /// its change this tick weighted by `w` (the gimbal fade), plus the channel's lag.
+    /// Channel `ch`: its slow part `k` of the way to the frames, their quick part
+    /// ([`Self::quick`]) shown at the gain, with the gain's excess and its change this tick
+    /// weighted by `w` (the group's fade), plus the channel's lag.
     fn channel(&mut self, out: &mut [f32; MAX_CHANNELS], ch: usize, k: f32, w: f32, wrap: bool) {
         let (g, dg) = (self.stages[2] - 1.0, self.stages[2] - self.before);
         let (g, dg) = (g * w, dg * w);
-        let (d, c) = (out[ch] - self.slow[ch], self.left * self.cut[ch]);
-        let d = if wrap {
-            wrap_deg(d) - wrap_deg(c)
-        } else {
-            d - c
-        };
+        let d = self.quick(out, ch, wrap);
         if !d.is_finite() {
             self.slow[ch] = out[ch];
             self.lag[ch] = 0.0;
@@ -172,6 +174,17 @@ impl Expression {
             out[ch] = v;
         } else {
             self.lag[ch] = 0.0;
+        }
+    }
+
+    /// Channel `ch`'s quick part: the frames (`out[ch]` without the blend's offset) less the
+    /// slow part, wrapped for a group's angle (which may come back a turn away after a cut).
+    fn quick(&self, out: &[f32; MAX_CHANNELS], ch: usize, wrap: bool) -> f32 {
+        let (d, c) = (out[ch] - self.slow[ch], self.left * self.cut[ch]);
+        if wrap {
+            wrap_deg(d) - wrap_deg(c)
+        } else {
+            d - c
         }
     }
 
@@ -220,7 +233,23 @@ impl Expression {
             }
             let b = wrap_deg(out[first + 1]).abs();
             let b = if b > 90.0 { 180.0 - b } else { b };
-            let w = ((GIMBAL_FADE.1 - b) / (GIMBAL_FADE.1 - GIMBAL_FADE.0)).clamp(0.0, 1.0);
+            let mut q = 0.0f32;
+            for ch in first..first + 3 {
+                q = q.max(self.quick(out, ch, true).abs());
+            }
+            let w = ((GIMBAL_FADE.1 - b) / (GIMBAL_FADE.1 - GIMBAL_FADE.0))
+                .min((QUICK_FADE.1 - q) / (QUICK_FADE.1 - QUICK_FADE.0))
+                .clamp(0.0, 1.0);
+            if q >= QUICK_FADE.1 {
+                // No gesture moves this far from its posture in half a second: the angles
+                // swung between two Euler forms of about one rotation, and an average across
+                // the swing is no posture. The slow part starts again from the frames.
+                #[allow(clippy::needless_range_loop)] // three arrays, one index
+                for ch in first..first + 3 {
+                    self.slow[ch] = out[ch] - self.left * self.cut[ch];
+                    self.lag[ch] = 0.0;
+                }
+            }
             for ch in first..first + 3 {
                 self.channel(out, ch, k, w, true);
                 done[ch / 32] |= 1 << (ch % 32);

@@ -457,6 +457,78 @@ fn the_expression_gain_scales_the_quick_part_around_the_posture() {
     }
 }
 
+/// One 4 s segment at 30 fps, constant but for one frame: at frame 60 channel 0 (a single
+/// angle) and the rotation group's outer angles (channels 1 and 3, middle angle 20) jump by
+/// the given degrees, the group's the other way round in channel 3.
+struct Swing(f32);
+
+impl LibraryFrames for Swing {
+    fn channels(&self) -> usize {
+        4
+    }
+    fn fps(&self) -> f32 {
+        30.0
+    }
+    fn segment_count(&self) -> usize {
+        1
+    }
+    fn segment_len(&self, _: usize) -> usize {
+        120
+    }
+    fn value(&self, _: usize, f: usize, ch: usize) -> f32 {
+        let a = if f < 60 { -0.5 } else { 0.5 } * self.0;
+        match ch {
+            0 | 1 => a,
+            2 => 20.0,
+            _ => -a,
+        }
+    }
+    fn group_count(&self) -> usize {
+        1
+    }
+    fn group(&self, _: usize) -> (usize, [u8; 3]) {
+        (1, [2, 1, 0])
+    }
+}
+
+/// A rotation group's quick part is scaled less the further it is from its slow part
+/// ([`expression::QUICK_FADE`]): a jump of 75 degrees gets half the gain's excess. A swing of
+/// 160 degrees, further than any gesture moves in half a second (two Euler forms of about one
+/// rotation), is not scaled, and the slow part starts again from the frames, so no average
+/// across the swing is shown as motion afterwards: at a gain of 1.3 the group's angles are the
+/// frames' at every tick. A single angle's jump is motion and is scaled in full (0.3 x 160
+/// degrees past the frames at the jump).
+#[test]
+fn a_rotation_group_is_scaled_less_the_further_it_swings() {
+    let (lo, hi) = expression::QUICK_FADE;
+    for jump in [75.0f32, 160.0] {
+        let lib = Swing(jump);
+        let mut p = Player::new();
+        p.set_gain(1.3);
+        let mut out = [0.0; MAX_CHANNELS];
+        for f in 0..120 {
+            p.tick(&lib, &mut out);
+            if f == 60 {
+                assert!((out[0] - jump * (0.5 + 0.3)).abs() < 1.0, "{:?}", &out[..4]);
+                let w = ((hi - jump) / (hi - lo)).clamp(0.0, 1.0);
+                let want = jump * (0.5 + 0.3 * w);
+                assert!((out[1] - want).abs() < 1.0, "jump {jump}: {:?}", &out[..4]);
+                assert!((out[3] + want).abs() < 1.0, "jump {jump}: {:?}", &out[..4]);
+            }
+            if jump > hi {
+                for ch in 1..4 {
+                    let want = lib.value(0, f, ch);
+                    assert!(
+                        (out[ch] - want).abs() < 1e-3,
+                        "tick {f} ch {ch}: {:?}",
+                        &out[..4]
+                    );
+                }
+            }
+        }
+    }
+}
+
 /// A change of gain changes the quick part's speed at once and its size over
 /// [`expression::RELAX_S`]: aimed from 1 to 2 at a crest of the sine (where the frames hardly
 /// move), over its first three ticks the shown pose steps less than half as far as
