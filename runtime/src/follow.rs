@@ -57,14 +57,15 @@
 //!   first pause step of a silence, so the motion follows the voice within a syllable, not
 //!   only at the next exit point. Resting, a gesture still playing (its cut into a rest waits
 //!   for a pause of its hands, a second or more at the rest's pace) is shown at a quarter of
-//!   its size ([`Expressive::caught`]): it settled sooner on every span measured. Live, the loudness is the front-end's 10 ms frames
-//!   ([`Voice::hear`]: a quick rise, a slower fall), not the syllables' levels: a syllable's
-//!   level is known only once the syllable has ended and been confirmed (about 0.09 s later),
-//!   and the hands' speed then trailed the voice by about 0.3 s (their correlation with the
-//!   loudness was highest with the speech moved 0.3 s later). With look-ahead the syllables'
-//!   levels take effect at their own time, and they set the size. The size follows the voice
-//!   under every tone: scaled by the style's neutral weight like the energy weight, an
-//!   `active` tone lost it and moved no faster than neutral speech (0.99x on new speech).
+//!   its size ([`Expressive::caught`]): it settled sooner on every span measured. Live, the
+//!   loudness is the front-end's 10 ms frames ([`Voice::hear`]: a quick rise, a slower
+//!   fall), not the syllables' levels: a syllable's level is known only once the syllable has
+//!   ended and been confirmed (about 0.09 s later), and the hands' speed then trailed the
+//!   voice by about 0.3 s (their correlation with the loudness was highest with the speech
+//!   moved 0.3 s later). With look-ahead the syllables' levels take effect at their own time,
+//!   and they set the size. The size follows the voice under every tone: scaled by the
+//!   style's neutral weight like the energy weight, an `active` tone lost it and moved no
+//!   faster than neutral speech (0.99x on new speech).
 //!
 //! The belief still chooses among segments of like energy, and the variety costs still apply
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is

@@ -263,13 +263,13 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     // has no panic to explain.
     let _ = err.write_str("panic at ");
     if let Some(at) = info.location() {
-        let line = [
+        let at = [
+            Part::Text(at.file()),
             Part::Text(":"),
             Part::Dec(at.line() as u64),
             Part::Text("\n"),
         ];
-        let _ = err.write_str(at.file());
-        let _ = drive::write_parts(&mut err, &line);
+        let _ = drive::write_parts(&mut err, &at);
     }
     exit(false)
 }

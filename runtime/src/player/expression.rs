@@ -153,13 +153,12 @@ impl Expression {
         }
     }
 
-    /// Channel `ch`: its slow part `k` of the way to the frames, their quick part
-    /// ([`Self::quick`]) shown at the gain, with the gain's excess and its change this tick
-    /// weighted by `w` (the group's fade), plus the channel's lag.
-    fn channel(&mut self, out: &mut [f32; MAX_CHANNELS], ch: usize, k: f32, w: f32, wrap: bool) {
+    /// Channel `ch` with quick part `d` ([`Self::quick`]): its slow part `k` of the way to the
+    /// frames, the quick part shown at the gain, with the gain's excess and its change this
+    /// tick weighted by `w` (the group's fade), plus the channel's lag.
+    fn channel(&mut self, out: &mut [f32; MAX_CHANNELS], ch: usize, k: f32, w: f32, d: f32) {
         let (g, dg) = (self.stages[2] - 1.0, self.stages[2] - self.before);
         let (g, dg) = (g * w, dg * w);
-        let d = self.quick(out, ch, wrap);
         if !d.is_finite() {
             self.slow[ch] = out[ch];
             self.lag[ch] = 0.0;
@@ -233,10 +232,11 @@ impl Expression {
             }
             let b = wrap_deg(out[first + 1]).abs();
             let b = if b > 90.0 { 180.0 - b } else { b };
-            let mut q = 0.0f32;
-            for ch in first..first + 3 {
-                q = q.max(self.quick(out, ch, true).abs());
+            let mut d = [0.0f32; 3];
+            for (i, d) in d.iter_mut().enumerate() {
+                *d = self.quick(out, first + i, true);
             }
+            let q = d.iter().fold(0.0f32, |q, d| q.max(d.abs()));
             let w = ((GIMBAL_FADE.1 - b) / (GIMBAL_FADE.1 - GIMBAL_FADE.0))
                 .min((QUICK_FADE.1 - q) / (QUICK_FADE.1 - QUICK_FADE.0))
                 .clamp(0.0, 1.0);
@@ -244,14 +244,16 @@ impl Expression {
                 // No gesture moves this far from its posture in half a second: the angles
                 // swung between two Euler forms of about one rotation, and an average across
                 // the swing is no posture. The slow part starts again from the frames.
-                #[allow(clippy::needless_range_loop)] // three arrays, one index
-                for ch in first..first + 3 {
+                for (i, d) in d.iter_mut().enumerate() {
+                    let ch = first + i;
                     self.slow[ch] = out[ch] - self.left * self.cut[ch];
                     self.lag[ch] = 0.0;
+                    *d = self.quick(out, ch, true);
                 }
             }
-            for ch in first..first + 3 {
-                self.channel(out, ch, k, w, true);
+            for (i, &d) in d.iter().enumerate() {
+                let ch = first + i;
+                self.channel(out, ch, k, w, d);
                 done[ch / 32] |= 1 << (ch % 32);
             }
         }
@@ -259,7 +261,8 @@ impl Expression {
         // -170 degrees are far apart).
         for ch in 0..n {
             if done[ch / 32] & (1 << (ch % 32)) == 0 {
-                self.channel(out, ch, k, 1.0, false);
+                let d = self.quick(out, ch, false);
+                self.channel(out, ch, k, 1.0, d);
             }
         }
     }
