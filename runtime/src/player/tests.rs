@@ -255,6 +255,81 @@ fn a_large_offset_blends_no_faster_than_the_cap() {
     assert_eq!(stretched, 9 * MAX_BLEND_STRETCH + 1);
 }
 
+/// A single angle and a rotation group (`Z, Y, X`), both turning 20 degrees per tick in
+/// segment 0; segment 1 holds still where segment 0's fifth frame is.
+struct Fast;
+
+impl LibraryFrames for Fast {
+    fn channels(&self) -> usize {
+        4
+    }
+    fn fps(&self) -> f32 {
+        30.0
+    }
+    fn segment_count(&self) -> usize {
+        2
+    }
+    fn segment_len(&self, _: usize) -> usize {
+        40
+    }
+    fn value(&self, c: usize, f: usize, ch: usize) -> f32 {
+        match (c, ch) {
+            (0, 0 | 1) => 20.0 * f as f32,
+            (1, 0 | 1) => 80.0,
+            _ => 0.0,
+        }
+    }
+    fn group_count(&self) -> usize {
+        1
+    }
+    fn group(&self, _: usize) -> (usize, [u8; 3]) {
+        (1, [2, 1, 0])
+    }
+}
+
+/// Known answer: a cut with no offset from a motion of `v0` per tick moves the pose on by
+/// `v0 (t + a t^2) e^(-a t)`, at most `0.84 v0 / a` past the new frames (at `a t = 1.618`).
+/// Out of 20 degrees per tick, 18 degrees past with no cap; with a cap of 5 the carried
+/// velocity is 5 and the pose goes at most 4.5 degrees past, a single angle and a rotation
+/// group alike; the first step after the cut is `0.76 v0` (`(1 + a) e^-a`).
+#[test]
+fn a_cut_carries_on_no_more_velocity_than_the_cap() {
+    let a = SETTLE / 9.0;
+    let furthest = |v0: f32| 0.8399 * v0 / a;
+    let run_past = |cap: f32| {
+        let mut p = Player::new();
+        p.set_blend_ticks(9);
+        p.set_speed_cap(cap);
+        let mut out = [0.0; MAX_CHANNELS];
+        for _ in 0..5 {
+            p.tick(&Fast, &mut out); // frames 0..=4: at 80, moving 20 per tick
+        }
+        assert_eq!(out[0], 80.0);
+        p.enter(&Fast, 1);
+        let (mut most, mut first) = ([0.0f32; 2], None);
+        for _ in 0..30 {
+            p.tick(&Fast, &mut out);
+            first.get_or_insert(out[0] - 80.0);
+            most[0] = most[0].max(out[0] - 80.0);
+            most[1] = most[1].max(wrap_deg(out[1] - 80.0));
+        }
+        assert_eq!([out[0], out[1]], [80.0, 80.0]);
+        (most, first.unwrap_or(0.0))
+    };
+    let (free, first) = run_past(0.0);
+    for m in free {
+        assert!((m - furthest(20.0)).abs() < 0.3, "{free:?}");
+    }
+    assert!((first - 20.0 * (1.0 + a) * libm::expf(-a)).abs() < 1e-3);
+    // A cap above the motion's speed changes nothing.
+    assert_eq!(run_past(25.0), (free, first));
+    let (capped, first) = run_past(5.0);
+    for m in capped {
+        assert!((m - furthest(5.0)).abs() < 0.1, "{capped:?}");
+    }
+    assert!((first - 5.0 * (1.0 + a) * libm::expf(-a)).abs() < 1e-3);
+}
+
 #[test]
 fn a_hard_cut_plays_the_new_frames_at_once() {
     let lib = Lib { groups: false };
