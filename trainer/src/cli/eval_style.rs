@@ -29,8 +29,8 @@ pub struct EvalStyleArgs {
     /// `active=1` `sad=1` `active=0.5,sad=0.5`).
     #[arg(long, num_args = 1.., default_value = "neutral")]
     pub styles: Vec<String>,
-    /// Runs of each style to average, the speech delayed by 0.2 s more each time (one run is
-    /// one draw).
+    /// Runs of each style to average, the speech delayed by 0.2 s more each time and by a
+    /// share of a 10 ms front-end frame (one run is one draw).
     #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub device_runs: u64,
     /// Print one JSON object.

@@ -52,7 +52,7 @@ use serde::Serialize;
 use super::error::EvalError;
 use super::metrics::{measure, MotionMetrics, Speech};
 use super::playback::{
-    play_ahead, play_baked, play_delayed, play_schedule, shuffle_blocks, Playback,
+    play_ahead, play_baked, play_delayed, play_schedule, shuffle_blocks, Lead, Playback,
 };
 use super::reference::{shown_speed_histogram, speech_matched_reference};
 use super::signals::speed_histogram;
@@ -79,7 +79,8 @@ pub struct MotionEval {
     /// Random runs to average.
     pub random_runs: u64,
     /// Runs of each device method to average (the speech delayed by [`PHASE_STEP_S`]
-    /// more of silence each time; 1: the device as it runs, alone).
+    /// more of silence each time, and by a share of a front-end frame: `Lead::of_run`; 1:
+    /// the device as it runs, alone).
     pub device_runs: u64,
     /// How to pack (costs, device settings, effectors); the rig is the library's full
     /// skeleton.
@@ -288,10 +289,10 @@ impl Ablation {
 pub const PHASE_STEP_S: f64 = 0.2;
 
 /// Device runs (and random runs) a [`MotionEval`] averages by default. Single runs of one
-/// method on two minutes of speech spread by 0.02-0.04 in beat alignment and about 0.08 in
-/// speech coupling (standard deviations), as much as the methods differ; 30 runs bring a
-/// mean's standard error to about a fifth of that (10 left it at a third, and comparisons
-/// that flipped between settings).
+/// method on two minutes of held-out speech spread by 0.02-0.03 in speech coupling and in
+/// beat alignment (standard deviations; 0.09 in coupling on ten seconds), as much as the
+/// methods differ; 30 runs bring a mean's standard error to about 0.006 (0.016 on ten
+/// seconds).
 pub const DEFAULT_DEVICE_RUNS: u64 = 30;
 
 fn mean(ms: &[MotionMetrics]) -> MotionMetrics {
@@ -393,9 +394,10 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     // Drawn only when stderr is a terminal.
     let progress = crate::progress::spinner("eval-motion: the device and its ablations");
     // Each device method runs `device_runs` times, the speech delayed by a few more frames
-    // each time: its choices depend on where the animation stands when each syllable comes,
-    // so one run is one draw; the variety figures are of the first (undelayed) run, the
-    // others the mean.
+    // and a share of a front-end frame each time: its choices depend on where the animation
+    // stands when each syllable comes and on where the syllables fall in the front-end's
+    // frames, so one run is one draw; the variety figures are of the first (undelayed) run,
+    // the others the mean.
     let runs = e.device_runs.max(1) as usize;
     let step = ((PHASE_STEP_S * fps).round() as usize).max(1);
     let prior: Vec<f32> = model.state_prior.iter().map(|&v| v as f32).collect();
@@ -415,11 +417,18 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
             } else {
                 &samples
             };
-            let (p, m) = play_delayed(&blob, input, rate, frames, run * step, |c| match method {
-                Ablation::Pure => c.set_variety(Variety::NONE),
-                Ablation::Prior => c.hold_belief(Some(&prior)),
-                Ablation::None | Ablation::Shuffled => {}
-            })?;
+            let (p, m) = play_delayed(
+                &blob,
+                input,
+                rate,
+                frames,
+                Lead::of_run(run, step, rate),
+                |c| match method {
+                    Ablation::Pure => c.set_variety(Variety::NONE),
+                    Ablation::Prior => c.hold_belief(Some(&prior)),
+                    Ablation::None | Ablation::Shuffled => {}
+                },
+            )?;
             if method == Ablation::None && run == 0 {
                 made = m;
             }
@@ -439,7 +448,14 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
         }
         let mut ms = Vec::with_capacity(runs);
         for run in 0..runs {
-            let p = play_ahead(&blob, &samples, rate, frames, run * step, h.lookahead())?;
+            let p = play_ahead(
+                &blob,
+                &samples,
+                rate,
+                frames,
+                Lead::of_run(run, step, rate),
+                h.lookahead(),
+            )?;
             ms.push(measured(&p)?);
         }
         rows.push(Row::of_runs(&h.row_name(), &ms));

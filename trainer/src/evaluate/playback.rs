@@ -80,8 +80,7 @@ pub(crate) fn play_online(
     Ok((out, made))
 }
 
-/// The device's motion on `samples` delayed by `delay` frames of silence (as
-/// [`play_delayed`]) with the controller hearing the audio `l.ms` before it is played: fed
+/// The device's motion on `samples` after `lead` of silence (as [`play_delayed`]) with the controller hearing the audio `l.ms` before it is played: fed
 /// the samples followed by that much silence (after a recording, nothing), so every tick of
 /// the audio is played.
 pub(crate) fn play_ahead(
@@ -89,7 +88,7 @@ pub(crate) fn play_ahead(
     samples: &[i16],
     rate: u32,
     frames: usize,
-    delay: usize,
+    lead: Lead,
     l: Lookahead,
 ) -> Result<Playback, EvalError> {
     let mut input = samples.to_vec();
@@ -97,7 +96,7 @@ pub(crate) fn play_ahead(
         samples.len() + (l.ms as usize * rate as usize).div_ceil(1000),
         0,
     );
-    let (p, _) = play_delayed(blob, &input, rate, frames, delay, |c| c.set_lookahead(l))?;
+    let (p, _) = play_delayed(blob, &input, rate, frames, lead, |c| c.set_lookahead(l))?;
     Ok(p)
 }
 
@@ -160,18 +159,51 @@ pub fn shuffle_blocks(samples: &[i16], rate: u32, seed: u64) -> Vec<i16> {
     blocks.concat()
 }
 
-/// The device's motion on `samples` delayed by `delay` frames of silence, measured from where
-/// the speech starts (`frames` ticks), and its decisions.
+/// Where a device run's speech starts: after `frames` animation frames of silence and
+/// `phase` samples more (less than one of the front-end's 10 ms frames), so that runs meet
+/// the speech both with the animation elsewhere and at another point of the front-end's frame
+/// grid. With whole frames alone, every run that began with a rest (half a second of silence)
+/// heard exactly the same samples in the same frames and made the same choices from then on:
+/// 30 runs were three or four draws. A real microphone meets the speech at any phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Lead {
+    /// Animation frames of silence (the measured trace starts after them).
+    pub frames: usize,
+    /// Samples of silence more, less than one front-end frame (the speech then starts that
+    /// much after the trace's time 0: under 10 ms).
+    pub phase: usize,
+}
+
+/// The fractional part of the golden ratio: run `k`'s phase is `frac(k * GOLDEN)` of a
+/// front-end frame, so any number of runs spreads evenly over the frame.
+const GOLDEN: f64 = 0.618_033_988_749_894_9;
+
+impl Lead {
+    /// Run `run` of a series: `run * step` frames and a phase spread over the front-end's
+    /// 10 ms frame at `rate` Hz (run 0: no lead at all).
+    pub fn of_run(run: usize, step: usize, rate: u32) -> Self {
+        let hop = (rate / 100).max(1) as f64;
+        Self {
+            frames: run * step,
+            phase: ((run as f64 * GOLDEN).fract() * hop) as usize,
+        }
+    }
+}
+
+/// The device's motion on `samples` after `lead` of silence, measured from the end of the
+/// lead's whole frames (`frames` ticks), and its decisions.
 pub(crate) fn play_delayed(
     blob: &Blob<'_>,
     samples: &[i16],
     rate: u32,
     frames: usize,
-    delay: usize,
+    lead: Lead,
     setup: impl FnOnce(&mut BlobController<'_>),
 ) -> Result<(Playback, Vec<Made>), EvalError> {
-    let lead = (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize;
-    let mut input = vec![0i16; lead];
+    let delay = lead.frames;
+    let silence =
+        (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize + lead.phase;
+    let mut input = vec![0i16; silence];
     input.extend_from_slice(samples);
     let (mut p, made) = play_online(blob, &input, frames + delay, setup)?;
     p.poses.drain(..delay.min(p.poses.len()));
@@ -218,15 +250,46 @@ mod tests {
         let frames = (3.0 * fps) as usize;
         let silence = vec![0i16; 3 * rate as usize];
         let d = 7;
-        let (delayed, _) = play_delayed(&blob, &silence, rate, frames, d, |_| {}).unwrap();
+        let lead = Lead {
+            frames: d,
+            phase: 53,
+        };
+        let (delayed, _) = play_delayed(&blob, &silence, rate, frames, lead, |_| {}).unwrap();
         assert_eq!(delayed.poses.len(), frames);
-        let lead = (d as f64 * rate as f64 / fps).round() as usize;
+        let lead = (d as f64 * rate as f64 / fps).round() as usize + 53;
         let longer = vec![0i16; lead + silence.len()];
         let (whole, _) = play_online(&blob, &longer, frames + d, |_| {}).unwrap();
         assert_eq!(delayed.poses[..], whole.poses[d..]);
         assert_eq!(delayed.shown[..], whole.shown[d..]);
         // No delay: the plain run.
-        let (plain, _) = play_delayed(&blob, &silence, rate, frames, 0, |_| {}).unwrap();
+        let (plain, _) =
+            play_delayed(&blob, &silence, rate, frames, Lead::default(), |_| {}).unwrap();
         assert_eq!(plain.poses[..], whole.poses[..frames]);
+    }
+
+    /// Known answer: run 0 has no lead; run `k` is `k` steps of frames and a phase under one
+    /// 10 ms front-end frame (160 samples at 16 kHz), and 30 runs leave no tenth of the frame
+    /// without a phase (the golden-ratio sequence spreads evenly).
+    #[test]
+    fn runs_spread_their_phase_over_the_front_end_frame() {
+        assert_eq!(Lead::of_run(0, 12, 16_000), Lead::default());
+        assert_eq!(
+            Lead::of_run(1, 12, 16_000),
+            Lead {
+                frames: 12,
+                phase: 98
+            }
+        );
+        assert_eq!(Lead::of_run(2, 12, 16_000).phase, 37);
+        let phases: Vec<usize> = (0..30).map(|k| Lead::of_run(k, 12, 16_000).phase).collect();
+        assert!(phases.iter().all(|&p| p < 160));
+        for tenth in 0..10 {
+            assert!(
+                phases.iter().any(|&p| p / 16 == tenth),
+                "no phase in tenth {tenth}: {phases:?}"
+            );
+        }
+        // Whatever the rate, under one frame.
+        assert!((0..100).all(|k| Lead::of_run(k, 1, 44_100).phase < 441));
     }
 }

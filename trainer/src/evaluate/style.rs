@@ -10,7 +10,8 @@
 //!
 //! As in `eval-motion`, everything runs the packed bytes through the runtime's device loop
 //! (the style set on its controller with `Controller::set_style`), `device_runs` times per
-//! style with the speech delayed 0.2 s more each time: one run is one draw (single runs put
+//! style with the speech delayed 0.2 s more each time (and by a share of a front-end frame, as
+//! in `eval-motion`): one run is one draw (single runs put
 //! active at x1.03 to x1.24 on the two beat-scott monologues). The hand speed is the mean over
 //! the runs, the geometric means are over all the runs' segments, and the segment and
 //! decision counts are per run.
@@ -20,7 +21,7 @@ use serde::Serialize;
 
 use super::error::EvalError;
 use super::motion::{load_audio, MotionEval, PHASE_STEP_S};
-use super::playback::play_delayed;
+use super::playback::{play_delayed, Lead};
 use crate::control::style::parse_weights;
 use crate::inference::model::InferenceModel;
 use crate::motion::{analyze, SegmentParams};
@@ -97,9 +98,16 @@ pub fn evaluate_styles(
         let (mut speeds, mut logs, mut segments, mut decisions) = (0.0, [0.0f64; 6], 0usize, 0);
         for run in 0..runs {
             let mut refused = None;
-            let (played, made) = play_delayed(&blob, &samples, rate, frames, run * step, |c| {
-                refused = c.set_style(w).err();
-            })?;
+            let (played, made) = play_delayed(
+                &blob,
+                &samples,
+                rate,
+                frames,
+                Lead::of_run(run, step, rate),
+                |c| {
+                    refused = c.set_style(w).err();
+                },
+            )?;
             if let Some(err) = refused {
                 return Err(EvalError::Input(format!("--styles {spec}: {err}")));
             }
