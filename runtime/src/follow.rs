@@ -350,6 +350,20 @@ impl RestSet {
         me
     }
 
+    /// The rest segments of a character that follows the voice as `follow` says: [`Self::of`],
+    /// or none if it never rests.
+    pub fn resting_as<T: PolicyTables + ?Sized>(
+        t: &T,
+        segments: usize,
+        follow: &VoiceFollow,
+    ) -> Self {
+        if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
+            Self::of(t, segments)
+        } else {
+            Self::EMPTY
+        }
+    }
+
     /// The segments.
     pub fn segments(&self) -> &[u16] {
         &self.segments[..self.len]

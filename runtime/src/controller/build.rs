@@ -59,8 +59,7 @@ impl<'a, A: Arith> Controller<'a, Blob<'a>, Blob<'a>, A> {
         me.variety = blob.variety();
         me.label_timeout_ms = blob.label_timeout_ms();
         me.set_follow(blob.follow());
-        let blend = me.ms_ticks(blob.blend_ms());
-        me.player.set_blend_ticks(blend);
+        me.set_blend_ms(blob.blend_ms());
         me.player
             .set_speed_cap(crate::player::library_speed_cap(blob));
         Ok(me)

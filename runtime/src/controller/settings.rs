@@ -41,11 +41,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     pub fn set_follow(&mut self, follow: VoiceFollow) {
         self.follow = follow;
         self.expression = Expressive::of(&follow);
-        self.rest = if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
-            RestSet::of(self.tables, self.lib.segment_count())
-        } else {
-            RestSet::EMPTY
-        };
+        self.rest = RestSet::resting_as(self.tables, self.lib.segment_count(), &follow);
+        self.player.set_rest_segments(self.rest);
     }
 
     /// How the character follows the voice.
@@ -116,6 +113,13 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     /// How far ahead of its playback the controller hears the audio.
     pub fn lookahead(&self) -> Lookahead {
         self.ahead.settings()
+    }
+
+    /// Sets how long a cut blends (ms; a controller from a blob has the blob's, one over
+    /// other tables none: hard cuts).
+    pub fn set_blend_ms(&mut self, ms: u32) {
+        let ticks = self.ms_ticks(ms);
+        self.player.set_blend_ticks(ticks);
     }
 
     /// Sets when decisions happen (the default is [`DecisionTiming::DEFAULT`]).

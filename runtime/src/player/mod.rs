@@ -26,7 +26,10 @@
 //! further), and a pose already faster than the library ever moves (a cut during another
 //! cut's blend, out of a fast stroke) swung a held-out run's arm 140 degrees past the new
 //! frames and back, a hand step of 28 cm in one frame. Within the library's 99th-percentile
-//! speed the pose's velocity is continuous across a cut as before.
+//! speed the pose's velocity is continuous across a cut as before. A cut into one of the
+//! library's rest segments ([`Player::set_rest_segments`]: the character comes to rest in a
+//! pause) blends at [`REST_BLEND`] of the cap: arms lowered at a gesture's pace read as
+//! dropped, and the hands moved fastest just as the speech stopped.
 //!
 //! Channels are blended as what they are:
 //! - a single angle (a servo, a twist, one Euler angle of a puppet): offset in degrees, linear
@@ -58,6 +61,7 @@
 pub mod expression;
 mod library;
 
+use crate::follow::RestSet;
 use expression::Expression;
 
 pub use library::{library_speed_cap, within_limits, LibraryFrames};
@@ -80,6 +84,12 @@ const PEAK: f32 = 2.0 / (core::f32::consts::E * core::f32::consts::E);
 /// The longest a cut's blend is stretched to keep the offset within the speed cap, as a
 /// multiple of the set blend time.
 pub const MAX_BLEND_STRETCH: u32 = 3;
+
+/// The share of the speed cap a cut into a rest segment blends at (see the module docs):
+/// chosen on the shared takes, where the hands' coupling to the voice rose on the 067 take
+/// (9-joint model and library) from +0.344 to +0.376 at 0.5 and +0.381 at 0.3 and stayed
+/// within 0.005 elsewhere (the blend is stretched at most [`MAX_BLEND_STRETCH`] times).
+pub const REST_BLEND: f32 = 0.5;
 
 /// The slowest playback rate (frames per tick): half the library's pace. Calm motion at half
 /// speed still reads as breathing and drift; slower, it reads as slow motion.
@@ -155,6 +165,8 @@ pub struct Player {
     cut_ticks: u32,
     /// Fastest the offset may move (degrees per tick at its start; 0: no cap).
     speed_cap: f32,
+    /// The library's rest segments (entered at [`REST_BLEND`] of the speed cap).
+    rest: RestSet,
     blending: bool,
     /// Frames advanced per tick ([`MIN_RATE`]..=[`MAX_RATE`]).
     rate: f32,
@@ -182,6 +194,7 @@ impl Player {
             blend_ticks: 0,
             cut_ticks: 0,
             speed_cap: 0.0,
+            rest: RestSet::EMPTY,
             blending: false,
             rate: 1.0,
             phase: 0.0,
@@ -246,6 +259,17 @@ impl Player {
     /// Cuts blend over `ticks` animation ticks (0: hard cuts).
     pub fn set_blend_ticks(&mut self, ticks: u32) {
         self.blend_ticks = ticks;
+    }
+
+    /// The library's rest segments (`follow::RestSet`): a cut into one blends at
+    /// [`REST_BLEND`] of the speed cap (none by default).
+    pub fn set_rest_segments(&mut self, rest: RestSet) {
+        self.rest = rest;
+    }
+
+    /// The blend time of a cut (ticks), as set ([`set_blend_ticks`](Self::set_blend_ticks)).
+    pub fn blend_ticks(&self) -> u32 {
+        self.blend_ticks
     }
 
     /// Caps how fast a blend moves the pose: a cut whose offset (the largest over channels,
@@ -395,7 +419,12 @@ impl Player {
             // tick: keep that within the cap.
             // The offset x0 (1 + a t + (a t)^2 / 2) e^(-a t) moves fastest at t = 2 / a, by
             // 2 a x0 / e^2 per tick: keep that within the cap.
-            let need = SETTLE * largest * PEAK / self.speed_cap;
+            let cap = if self.rest.contains(c) {
+                self.speed_cap * REST_BLEND
+            } else {
+                self.speed_cap
+            };
+            let need = SETTLE * largest * PEAK / cap;
             let most = self.blend_ticks.saturating_mul(MAX_BLEND_STRETCH);
             if need.is_finite() && need > self.blend_ticks as f32 {
                 // Between blend_ticks (need is above it) and most.

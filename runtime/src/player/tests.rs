@@ -330,6 +330,87 @@ fn a_cut_carries_on_no_more_velocity_than_the_cap() {
     assert!((first - 5.0 * (1.0 + a) * libm::expf(-a)).abs() < 1e-3);
 }
 
+/// Two segments' energies (the rest set's source): segment 1 the calmer.
+struct Energies;
+
+impl crate::policy::PolicyTables for Energies {
+    fn states(&self) -> usize {
+        1
+    }
+    fn exit_count(&self) -> usize {
+        0
+    }
+    fn exit_segment(&self, _: usize) -> usize {
+        0
+    }
+    fn exit_frame(&self, _: usize) -> usize {
+        0
+    }
+    fn exit_is_end(&self, _: usize) -> bool {
+        true
+    }
+    fn first_exit(&self, _: usize) -> usize {
+        0
+    }
+    fn u(&self, _: usize, _: usize) -> f32 {
+        0.0
+    }
+    fn u_cont(&self, _: usize, _: usize) -> f32 {
+        0.0
+    }
+    fn successor_count(&self, _: usize) -> usize {
+        0
+    }
+    fn successor(&self, _: usize, _: usize) -> (usize, f32) {
+        (0, 0.0)
+    }
+    fn energy(&self, c: usize) -> f32 {
+        [1.0, -1.0][c.min(1)]
+    }
+}
+
+/// Known answer: a cut into a rest segment blends at [`REST_BLEND`] of the speed cap. From 0
+/// to 100 degrees with a cap of 20, a gesture's blend takes `ceil(8.406 * 100 * 2 / (e^2 *
+/// 20)) = 12` ticks; into a rest, at half the cap, 23, no step over 10; back out of the rest
+/// into the gesture, 12 again.
+#[test]
+fn a_cut_into_a_rest_blends_at_a_share_of_the_cap() {
+    let lib = FnLib {
+        segs: 2,
+        len: 60,
+        f: |c, _| 100.0 * c as f32,
+    };
+    let blend = |rest: RestSet, into: usize| {
+        let mut p = Player::new();
+        p.set_blend_ticks(9);
+        p.set_speed_cap(20.0);
+        p.set_rest_segments(rest);
+        let mut out = [0.0; MAX_CHANNELS];
+        p.enter(&lib, 1 - into);
+        for _ in 0..3 {
+            p.tick(&lib, &mut out);
+        }
+        p.enter(&lib, into);
+        let target = 100.0 * into as f32;
+        let (mut prev, mut most, mut ticks) = (out[0], 0.0f32, 0);
+        while out[0] != target && ticks < 100 {
+            p.tick(&lib, &mut out);
+            most = most.max((out[0] - prev).abs());
+            prev = out[0];
+            ticks += 1;
+        }
+        (most, ticks)
+    };
+    let rest = RestSet::of(&Energies, 2);
+    assert_eq!(rest.segments(), &[1]);
+    let (_, gesture) = blend(RestSet::EMPTY, 1);
+    assert_eq!(gesture, 12 + 1);
+    let (most, resting) = blend(rest, 1);
+    assert_eq!(resting, 23 + 1);
+    assert!(most <= 10.0, "{most}");
+    assert_eq!(blend(rest, 0).1, 12 + 1);
+}
+
 #[test]
 fn a_hard_cut_plays_the_new_frames_at_once() {
     let lib = Lib { groups: false };

@@ -4,6 +4,7 @@
 use super::error::ShowError;
 use super::parse::{Commands, Show};
 use crate::blob::Blob;
+use crate::follow::RestSet;
 use crate::player::{
     library_speed_cap, within_limits, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
 };
@@ -40,27 +41,31 @@ pub struct ShowPlayer<'a, L: LibraryFrames + ?Sized> {
 
 impl<'a> ShowPlayer<'a, Blob<'a>> {
     /// The player of `show` over `blob`, set up as the controller sets up its player (the
-    /// blob's blend time and the library's speed cap), after
+    /// blob's blend time, the library's speed cap and its rest segments), after
     /// [`Show::check_against`] `blob`.
     pub fn from_blob(show: &Show<'a>, blob: &'a Blob<'a>) -> Result<Self, ShowError> {
         show.check_against(blob)?;
         let fps_milli = show.header().fps_milli as u64;
         // As the controller's `ms_ticks`.
         let blend = (blob.blend_ms() as u64 * fps_milli).div_ceil(1_000_000);
-        Self::new(
+        let mut me = Self::new(
             show,
             blob,
             blend.min(u32::MAX as u64) as u32,
             library_speed_cap(blob),
-        )
+        )?;
+        let segments = LibraryFrames::segment_count(blob);
+        me.player
+            .set_rest_segments(RestSet::resting_as(blob, segments, &blob.follow()));
+        Ok(me)
     }
 }
 
 impl<'a, L: LibraryFrames + ?Sized> ShowPlayer<'a, L> {
     /// The player of `show` over `lib`, whose cuts blend over `blend_ticks` with the speed cap
     /// `speed_cap` (degrees per tick; what the controller's player had: a controller from a
-    /// blob sets both from the blob, [`from_blob`](ShowPlayer::from_blob)), after
-    /// [`Show::check_library`].
+    /// blob sets both from the blob, and its rest segments, [`from_blob`](ShowPlayer::from_blob);
+    /// here none), after [`Show::check_library`].
     pub fn new(
         show: &Show<'a>,
         lib: &'a L,

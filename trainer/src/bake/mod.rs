@@ -160,6 +160,11 @@ fn commands(
     let blend = (blob.blend_ms() as u64 * fps_milli).div_ceil(1_000_000);
     player.set_blend_ticks(blend.min(u32::MAX as u64) as u32);
     player.set_speed_cap(library_speed_cap(blob));
+    player.set_rest_segments(RestSet::resting_as(
+        blob,
+        LibraryFrames::segment_count(blob),
+        &blob.follow(),
+    ));
     let mut pose = [0.0f32; MAX_CHANNELS];
     let (mut next, mut applied) = (0usize, 0usize);
     let mut rate = 1.0f32;

@@ -130,12 +130,18 @@ fn hold_to(p: &mut Playback, frames: usize) {
 }
 
 /// Plays a schedule of library frames through the runtime's player over the blob's frames,
-/// with the blob's inertialization at every entry.
+/// with the blob's inertialization at every entry (set up as the controller's: blend time,
+/// speed cap, rest segments).
 pub fn play_schedule(blob: &Blob<'_>, schedule: &[Played]) -> Playback {
     let mut player = Player::new();
     let blend = (blob.blend_ms() as f64 * blob.fps() as f64 / 1000.0).ceil() as u32;
     player.set_blend_ticks(blend);
     player.set_speed_cap(gesture_runtime::player::library_speed_cap(blob));
+    player.set_rest_segments(gesture_runtime::follow::RestSet::resting_as(
+        blob,
+        gesture_runtime::player::LibraryFrames::segment_count(blob),
+        &blob.follow(),
+    ));
     let mut out = Playback::default();
     let mut pose = [0.0f32; MAX_CHANNELS];
     let n = blob.channels();
