@@ -188,7 +188,30 @@ fn run_on(
     held: Option<&[f32]>,
     shown: bool,
 ) -> Vec<Rec> {
-    let t = tables();
+    run_over(
+        &tables(),
+        lib,
+        (audio, chunk, finish),
+        timing,
+        variety,
+        held,
+        shown,
+        0,
+    )
+}
+
+/// [`run_on`] over tables `t`, cuts blending over `blend_ms`.
+#[allow(clippy::too_many_arguments)]
+fn run_over(
+    t: &Tables,
+    lib: &Lib,
+    (audio, chunk, finish): (&[i16], usize, bool),
+    timing: DecisionTiming,
+    variety: Variety,
+    held: Option<&[f32]>,
+    shown: bool,
+    blend_ms: u32,
+) -> Vec<Rec> {
     let crf_bytes_init = [0u8; 4];
     let mut trans = Vec::new();
     for v in [400i16, -400, -400, 400] {
@@ -208,9 +231,10 @@ fn run_on(
     )
     .unwrap();
     let g = gmm();
-    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, lib).unwrap();
+    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, t, lib).unwrap();
     assert_eq!(c.timing(), DecisionTiming::DEFAULT);
     c.set_timing(timing);
+    c.set_blend_ms(blend_ms);
     c.set_variety(variety);
     c.hold_belief(held);
     let mut out = Vec::new();
@@ -767,4 +791,51 @@ fn a_cut_decided_mid_segment_waits_for_the_hands_to_pause() {
             "beats every {beat_every}"
         );
     }
+}
+
+/// No cut follows another within a quarter of the blend: segment 2's first interruption exit
+/// point is 2 frames in, and a cut's blend is 400 ms (12 ticks at 30 fps); after a cut into
+/// segment 2 that exit point is passed by (its next one, frame 29, decides), where with hard
+/// cuts it decides (and, leaving being cheaper there, cuts again).
+#[test]
+fn an_exit_point_early_in_a_cut_s_blend_is_passed_by() {
+    let mut t = tables();
+    t.exits[3] = (2, 2, false);
+    // Segment 2 is the cheapest choice and leaving it at its interruption the cheaper action.
+    t.u = vec![[3.0, 3.0], [3.0, 3.0], [0.0, 0.0]];
+    t.u_cont[3] = [5.0, 5.0];
+    let audio = speech(12.0);
+    let held = [0.0, 1.0];
+    let run = |blend_ms: u32| {
+        run_over(
+            &t,
+            &Lib::plain(),
+            (&audio, 160, false),
+            DecisionTiming::IMMEDIATE,
+            Variety::NONE,
+            Some(&held),
+            true,
+            blend_ms,
+        )
+    };
+    // Decisions at exit 3 (segment 2, frame 2) on a visit that entered segment 2 by a cut.
+    let early = |recs: &[Rec]| {
+        let sh = shown(recs);
+        let entered_2 = recs
+            .iter()
+            .any(|r| matches!(r, Rec::Decision(_, _, Choice::Enter(2))));
+        let at_3 = recs
+            .iter()
+            .filter(|r| matches!(r, Rec::Decision(t, 3, _) if sh[*t as usize].0 == 2))
+            .count();
+        (entered_2, at_3)
+    };
+    let (entered, hard) = early(&run(0));
+    assert!(
+        entered && hard > 0,
+        "hard cuts: entered 2 {entered}, decisions at exit 3 {hard}"
+    );
+    let (entered, blended) = early(&run(400));
+    assert!(entered, "no entry into segment 2");
+    assert_eq!(blended, 0);
 }
