@@ -87,14 +87,15 @@ pub use labels::{LabelError, LABEL_QUEUE};
 use crate::prosody::arith::{Arith, DefaultArith};
 use crate::prosody::{Event, FrontEnd, ProsodyConfig};
 
-/// The share of a cut's blend time in which an interruption exit point of the segment just
-/// entered is passed by: a decision there cut again from the blend a few frames in (a segment
+/// An interruption exit point of the segment just entered by a cut, in the first
+/// `1 / FRESH_BLEND` of the cut's blend time, is passed by: a decision there cut again from
+/// the blend a few frames in (a segment
 /// with an exit point 3 frames after its start), adding a second offset, with the velocity the
 /// first was closing at, to the first; on beat-scott the hands' largest step at a cut over 30
 /// runs was 2.29 cm (the capture's 99th-percentile step: 2.23), and 1.40 cm with a quarter
 /// (100 ms of a 400 ms blend). Half a blend also delayed decisions enough to lose coupling
 /// with the 067 library (-0.012).
-pub const FRESH_BLEND: f32 = 0.25;
+pub const FRESH_BLEND: u32 = 4;
 
 /// A cut decided and waiting for the hands to pause.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -605,29 +606,20 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             frame: self.player.frame().min(u16::MAX as usize) as u16,
         };
         self.play(command, sink);
-        self.record_entry(c, tick.min(u32::MAX as u64) as u32);
-        // An interruption exit point in the first part of the cut's blend is passed by (see
-        // `FRESH_BLEND`).
-        let settled =
-            self.player.frame() + (self.player.blend_ticks() as f32 * FRESH_BLEND) as usize;
-        let mut x = self.exit;
-        while !self.tables.exit_is_end(x)
-            && self.tables.exit_frame(x) < settled
-            && x + 1 < self.tables.exit_count()
-        {
-            x += 1;
-        }
-        self.exit = x;
+        // An interruption exit point early in the cut's blend is passed by (`FRESH_BLEND`).
+        let fresh = (self.player.blend_ticks() / FRESH_BLEND) as usize;
+        self.record_entry(c, tick.min(u32::MAX as u64) as u32, fresh);
     }
 
-    /// Remembers entering `c` at tick `now` and finds its first exit point not yet passed.
-    fn record_entry(&mut self, c: usize, now: u32) {
+    /// Remembers entering `c` at tick `now` and finds its first exit point not yet passed,
+    /// nor within `fresh` frames.
+    fn record_entry(&mut self, c: usize, now: u32, fresh: usize) {
         self.history.write(Visit {
             segment: c.min(u16::MAX as usize) as u16,
             tick: now,
         });
         let mut x = self.tables.first_exit(c);
-        let frame = self.player.frame();
+        let frame = self.player.frame() + fresh;
         while !self.tables.exit_is_end(x)
             && self.tables.exit_frame(x) < frame
             && x + 1 < self.tables.exit_count()
@@ -757,7 +749,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
                         at: self.pause_ahead(playing, shown).map(|f| (playing, f)),
                     });
                 } else if seamless {
-                    self.record_entry(c, now);
+                    self.record_entry(c, now, 0);
                 } else {
                     self.cut(c, decision.entry_frame, tick, sink);
                 }

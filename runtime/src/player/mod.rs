@@ -165,8 +165,6 @@ pub struct Player {
     cut_ticks: u32,
     /// Fastest the offset may move (degrees per tick at its start; 0: no cap).
     speed_cap: f32,
-    /// The library's rest segments (entered at [`REST_BLEND`] of the speed cap).
-    rest: RestSet,
     blending: bool,
     /// Frames advanced per tick ([`MIN_RATE`]..=[`MAX_RATE`]).
     rate: f32,
@@ -176,6 +174,8 @@ pub struct Player {
     backward: bool,
     /// The expression stage after the blend ([`expression`]).
     expression: Expression,
+    /// The library's rest segments (entered at [`REST_BLEND`] of the speed cap).
+    rest: RestSet,
 }
 
 impl Player {
@@ -194,12 +194,12 @@ impl Player {
             blend_ticks: 0,
             cut_ticks: 0,
             speed_cap: 0.0,
-            rest: RestSet::EMPTY,
             blending: false,
             rate: 1.0,
             phase: 0.0,
             backward: false,
             expression: Expression::new(),
+            rest: RestSet::EMPTY,
         }
     }
 
@@ -276,7 +276,7 @@ impl Player {
     /// in degrees; a rotation group's angle) would decay faster than `deg_per_tick` at its
     /// fastest gets a longer blend, up to [`MAX_BLEND_STRETCH`] times the set time (0 or a
     /// non-finite value: no cap), and the velocity a cut carries on is held within it (per
-    /// single angle; a rotation group's turning speed). The controller sets
+    /// single angle; a rotation group's turning about each axis). The controller sets
     /// [`library_speed_cap`].
     pub fn set_speed_cap(&mut self, deg_per_tick: f32) {
         self.speed_cap = if deg_per_tick.is_finite() && deg_per_tick > 0.0 {
@@ -387,18 +387,15 @@ impl Player {
             } else {
                 [0.0; 3]
             };
-            let v = [w_s[0] - w_t[0], w_s[1] - w_t[1], w_s[2] - w_t[2]];
-            // The offset's velocity within the speed cap (its turning speed, radians per
-            // tick; see the module docs).
-            let speed = libm::sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-            let cap = self.speed_cap * (core::f32::consts::PI / 180.0);
-            let keep = if cap > 0.0 && speed > cap {
-                cap / speed
+            // The offset's velocity within the speed cap (its turning speed about each axis,
+            // radians per tick; see the module docs).
+            let cap = if self.speed_cap > 0.0 {
+                self.speed_cap * (core::f32::consts::PI / 180.0)
             } else {
-                1.0
+                f32::INFINITY
             };
             for k in 0..3 {
-                let v0 = v[k] * keep;
+                let v0 = (w_s[k] - w_t[k]).max(-cap).min(cap);
                 self.off[first + k] = if x0[k].is_finite() { x0[k] } else { 0.0 };
                 self.vel[first + k] = if v0.is_finite() { v0 } else { 0.0 };
                 grouped[(first + k) / 8] |= 1 << ((first + k) % 8);
@@ -412,7 +409,7 @@ impl Player {
             for ch in 0..n {
                 if grouped[ch / 8] & (1 << (ch % 8)) == 0 {
                     largest = largest.max(self.off[ch].abs());
-                    self.vel[ch] = self.vel[ch].clamp(-cap, cap);
+                    self.vel[ch] = self.vel[ch].max(-cap).min(cap);
                 }
             }
             // The spring x0 (1 + a t) e^(-a t) moves fastest at t = 1/a, by a x0 / e per
