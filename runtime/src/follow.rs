@@ -154,8 +154,23 @@ pub fn rest_rate(energy: f32) -> f32 {
     }
 }
 
-/// The calmest segments, candidates at every exit point while resting.
-pub const REST_SET: usize = 6;
+/// The calmest segments, candidates at every exit point while resting (re-exported from
+/// [`crate::rest`]).
+pub use crate::rest::{RestSet, REST_SET};
+
+/// The rest segments of a character that follows the voice as `follow` says: the calmest
+/// ([`RestSet::of`]), or none if it never rests.
+pub fn rest_segments<T: PolicyTables + ?Sized>(
+    t: &T,
+    segments: usize,
+    follow: &VoiceFollow,
+) -> RestSet {
+    if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
+        RestSet::of(t, segments)
+    } else {
+        RestSet::EMPTY
+    }
+}
 
 /// The calmest of those, candidates at every exit point while resting: the selector's own
 /// bound ([`crate::policy::REST_EXTRAS`]).
@@ -304,93 +319,6 @@ impl Voice {
 impl Default for Voice {
     fn default() -> Self {
         Self::new()
-    }
-}
-
-/// The calmest segments of `t` (lowest energy, ties to the lower index), in order of energy:
-/// [`REST_SET`], or the calmer half of a smaller library (at least one), so a rest is never
-/// any segment at all.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RestSet {
-    segments: [u16; REST_SET],
-    len: usize,
-    /// The highest energy among them (-inf when there are none).
-    energy: f32,
-}
-
-impl RestSet {
-    /// No rest segments.
-    pub const EMPTY: Self = Self {
-        segments: [0; REST_SET],
-        len: 0,
-        energy: f32::NEG_INFINITY,
-    };
-
-    /// The calmest segments of `t` (one pass per slot over the segments).
-    pub fn of<T: PolicyTables + ?Sized>(t: &T, segments: usize) -> Self {
-        let mut me = Self::EMPTY;
-        let n = segments.min(u16::MAX as usize + 1);
-        let want = REST_SET.min((n / 2).max(1)).min(n);
-        while me.len < want {
-            let mut best: Option<(usize, f32)> = None;
-            for c in 0..n {
-                if me.contains(c) {
-                    continue;
-                }
-                let e = t.energy(c);
-                if best.is_none_or(|(_, b)| e < b) {
-                    best = Some((c, e));
-                }
-            }
-            let Some((c, e)) = best else { break };
-            me.segments[me.len] = c as u16;
-            me.len += 1;
-            me.energy = e;
-        }
-        me
-    }
-
-    /// The rest segments of a character that follows the voice as `follow` says: [`Self::of`],
-    /// or none if it never rests.
-    pub fn resting_as<T: PolicyTables + ?Sized>(
-        t: &T,
-        segments: usize,
-        follow: &VoiceFollow,
-    ) -> Self {
-        if follow.rest_cost > 0.0 && follow.rest_ms > 0 {
-            Self::of(t, segments)
-        } else {
-            Self::EMPTY
-        }
-    }
-
-    /// The segments.
-    pub fn segments(&self) -> &[u16] {
-        &self.segments[..self.len]
-    }
-
-    /// The calmest [`REST_EXTRAS`] of them: candidates at every exit point while resting.
-    pub fn extras(&self) -> &[u16] {
-        &self.segments[..self.len.min(REST_EXTRAS)]
-    }
-
-    /// The highest energy among them: while speaking, any segment this calm costs as a rest
-    /// (-inf when there are none).
-    pub fn energy(&self) -> f32 {
-        self.energy
-    }
-
-    /// Whether `c` is one of them.
-    pub fn contains(&self, c: usize) -> bool {
-        // An index loop: the boards' code is within a few hundred bytes of its budget.
-        let mut k = 0;
-        while k < self.len && k < REST_SET {
-            if self.segments[k] as usize == c {
-                return true;
-            }
-            k += 1;
-        }
-        false
     }
 }
 

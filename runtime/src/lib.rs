@@ -65,6 +65,7 @@ pub mod pca9685;
 pub mod player;
 pub mod policy;
 pub mod prosody;
+pub mod rest;
 pub mod rig;
 pub mod rotation;
 pub mod show;

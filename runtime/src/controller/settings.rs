@@ -2,7 +2,7 @@
 //! voice, varies, styles, serves labels, times its decisions and looks ahead.
 
 use super::{Controller, DecisionTiming, LabelError, Lookahead};
-use crate::follow::{Expressive, RestSet, VoiceFollow};
+use crate::follow::{rest_segments, Expressive, VoiceFollow};
 use crate::inference::MAX_STATES;
 use crate::player::LibraryFrames;
 use crate::policy::{PolicyTables, Style, StyleError, Variety};
@@ -41,7 +41,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     pub fn set_follow(&mut self, follow: VoiceFollow) {
         self.follow = follow;
         self.expression = Expressive::of(&follow);
-        self.rest = RestSet::resting_as(self.tables, self.lib.segment_count(), &follow);
+        self.rest = rest_segments(self.tables, self.lib.segment_count(), &follow);
         self.player.set_rest_segments(self.rest);
     }
 

@@ -61,7 +61,7 @@
 pub mod expression;
 mod library;
 
-use crate::follow::RestSet;
+use crate::rest::RestSet;
 use expression::Expression;
 
 pub use library::{library_speed_cap, within_limits, LibraryFrames};
@@ -261,7 +261,7 @@ impl Player {
         self.blend_ticks = ticks;
     }
 
-    /// The library's rest segments (`follow::RestSet`): a cut into one blends at
+    /// The library's rest segments ([`RestSet`]): a cut into one blends at
     /// [`REST_BLEND`] of the speed cap (none by default).
     pub fn set_rest_segments(&mut self, rest: RestSet) {
         self.rest = rest;
@@ -612,5 +612,7 @@ impl Default for Player {
     }
 }
 
+#[cfg(test)]
+mod cut_tests;
 #[cfg(test)]
 mod tests;

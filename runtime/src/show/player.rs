@@ -4,7 +4,7 @@
 use super::error::ShowError;
 use super::parse::{Commands, Show};
 use crate::blob::Blob;
-use crate::follow::RestSet;
+use crate::follow::rest_segments;
 use crate::player::{
     library_speed_cap, within_limits, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
 };
@@ -56,7 +56,7 @@ impl<'a> ShowPlayer<'a, Blob<'a>> {
         )?;
         let segments = LibraryFrames::segment_count(blob);
         me.player
-            .set_rest_segments(RestSet::resting_as(blob, segments, &blob.follow()));
+            .set_rest_segments(rest_segments(blob, segments, &blob.follow()));
         Ok(me)
     }
 }

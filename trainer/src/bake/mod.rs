@@ -22,7 +22,7 @@ pub mod timeline;
 pub use error::BakeError;
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::follow::{rest_rate, RestSet};
+use gesture_runtime::follow::{rest_rate, rest_segments, RestSet};
 use gesture_runtime::player::{
     library_speed_cap, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
 };
@@ -160,7 +160,7 @@ fn commands(
     let blend = (blob.blend_ms() as u64 * fps_milli).div_ceil(1_000_000);
     player.set_blend_ticks(blend.min(u32::MAX as u64) as u32);
     player.set_speed_cap(library_speed_cap(blob));
-    player.set_rest_segments(RestSet::resting_as(
+    player.set_rest_segments(rest_segments(
         blob,
         LibraryFrames::segment_count(blob),
         &blob.follow(),

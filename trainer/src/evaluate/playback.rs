@@ -137,7 +137,7 @@ pub fn play_schedule(blob: &Blob<'_>, schedule: &[Played]) -> Playback {
     let blend = (blob.blend_ms() as f64 * blob.fps() as f64 / 1000.0).ceil() as u32;
     player.set_blend_ticks(blend);
     player.set_speed_cap(gesture_runtime::player::library_speed_cap(blob));
-    player.set_rest_segments(gesture_runtime::follow::RestSet::resting_as(
+    player.set_rest_segments(gesture_runtime::follow::rest_segments(
         blob,
         gesture_runtime::player::LibraryFrames::segment_count(blob),
         &blob.follow(),
