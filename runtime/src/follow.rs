@@ -128,7 +128,8 @@ impl Expressive {
 }
 
 /// The expression of a blob that follows the voice: 30 % larger at full voice level (5 dB
-/// above the speaker's running level), 30 % smaller at the other end, half size in a silence,
+/// above the speaker's running level), 30 % smaller 5 dB under it and on down to half size
+/// 15 dB under ([`QUIET_SPAN`]), half size in a silence,
 /// and half that for a gesture the rest caught in the middle. A third either way stays within
 /// how much one speaker's strokes vary in size between calm and emphatic phrases; chosen on
 /// tuning speech (docs/method.md).
@@ -178,6 +179,14 @@ pub use crate::policy::REST_EXTRAS;
 
 /// Voice level (the step feature, 10 dB units) at which the energy weight is full.
 pub const VOICE_SPAN: f32 = 0.5;
+
+/// Voice level under the speaker's running level (10 dB units) at which a gesture is shown
+/// at the pause's size: between `VOICE_SPAN` and this far under it the gain falls on from
+/// `1 - span` to `pause`, so the gaps between phrases, too short for a pause step (250 ms),
+/// shrink the gesture as a pause does. Chosen on the tuning spans (30 runs, coupling +0.544
+/// -> +0.550 on 9-joint 90-121 s, +0.610 -> +0.612 with the 067 library on the 001 take; 2.5
+/// gave +0.548 and +0.612) and on the report spans +0.003 to +0.009.
+pub const QUIET_SPAN: f32 = 1.5;
 
 /// Per 10 ms frame heard live, how far the loudness a gesture's size follows moves towards a
 /// louder frame (a time constant of 30 ms) and towards a quieter one (120 ms): it rises with a
@@ -285,8 +294,10 @@ impl Voice {
     /// The expression gain the voice asks for now ([`Expressive`]), `rest_plays` whether a
     /// rest segment is playing: resting, `e.caught` while a gesture still plays (the cut into
     /// a rest waits for a pause of its hands), `e.pause` once a rest plays and from the first
-    /// pause step of a silence; else `1 + e.span * clamp(level / VOICE_SPAN, -1, 1)` (`level`
-    /// the loudness heard, [`Voice::hear`], or without frames the last syllable's); within the
+    /// pause step of a silence; else `1 + e.span * min(level / VOICE_SPAN, 1)` down to
+    /// `1 - e.span` at `-VOICE_SPAN`, and from there down to `e.pause` at `-QUIET_SPAN`
+    /// ([`QUIET_SPAN`]; `level` the loudness heard, [`Voice::hear`], or without frames the
+    /// last syllable's); within the
     /// player's [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not finite. Under
     /// every tone alike: a tone chooses which gestures are played and how energetic they are,
     /// the voice how large they are shown.
@@ -295,8 +306,12 @@ impl Voice {
             e.caught
         } else if self.resting || self.silent_steps > 0 {
             e.pause
+        } else if self.now < -VOICE_SPAN {
+            // Quieter still, down to the pause's size at `QUIET_SPAN` under the level.
+            let s = ((-self.now - VOICE_SPAN) / (QUIET_SPAN - VOICE_SPAN)).min(1.0);
+            (1.0 - e.span) + (e.pause - (1.0 - e.span)) * s
         } else {
-            1.0 + e.span * (self.now / VOICE_SPAN).clamp(-1.0, 1.0)
+            1.0 + e.span * (self.now / VOICE_SPAN).min(1.0)
         };
         let (lo, hi) = crate::player::expression::GAIN_RANGE;
         if g.is_finite() {
@@ -357,18 +372,25 @@ mod tests {
         // A syllable's level, reported a syllable late, does not override what is heard.
         v.step(&F, false, -0.5, 250);
         assert!((v.gain(&e, false) - want).abs() < 1e-5);
-        // Silence (-300 dB counts as 30 dB under the level) for 10 frames: the slow fall.
-        for _ in 0..10 {
+        // Silence (-300 dB counts as 30 dB under the level) for 4 frames: the slow fall, to
+        // between 5 and 15 dB under the level, where the gain goes on down towards the pause's.
+        for _ in 0..4 {
             v.hear(-300.0, 60.0);
         }
-        let fall = -3.0 + (now + 3.0) * (1.0 - HEAR_RELEASE).powi(10);
-        let want = 1.0 + e.span * (fall / VOICE_SPAN).clamp(-1.0, 1.0);
+        let fall = -3.0 + (now + 3.0) * (1.0 - HEAR_RELEASE).powi(4);
+        assert!(fall < -VOICE_SPAN && fall > -QUIET_SPAN, "{fall}");
+        let share = (-fall - VOICE_SPAN) / (QUIET_SPAN - VOICE_SPAN);
+        let want = (1.0 - e.span) + (e.pause - (1.0 - e.span)) * share;
         assert!(
             (v.gain(&e, false) - want).abs() < 1e-5,
             "{}",
             v.gain(&e, false)
         );
-        assert!(fall < -0.5 && fall > -3.0);
+        // Six frames more: over 15 dB under, the pause's size.
+        for _ in 0..6 {
+            v.hear(-300.0, 60.0);
+        }
+        assert!((v.gain(&e, false) - e.pause).abs() < 1e-6);
         let g = v.gain(&e, false);
         v.hear(f32::NAN, 60.0);
         v.hear(70.0, f32::INFINITY);
@@ -376,6 +398,31 @@ mod tests {
         // A pause step still brings the pause's gain.
         v.step(&F, true, -3.0, 250);
         assert_eq!(v.gain(&e, false), e.pause);
+    }
+
+    /// Known answers of the size against the loudness: 1.3 at 5 dB or more above the level,
+    /// 0.7 at 5 dB under it, then on down to the pause's 0.5 at 15 dB under (0.6 halfway).
+    #[test]
+    fn quieter_than_the_level_the_gesture_shrinks_to_the_pause_s_size() {
+        let e = EXPRESSION;
+        for (level, want) in [
+            (1.0, 1.3),
+            (0.5, 1.3),
+            (0.0, 1.0),
+            (-0.25, 0.85),
+            (-0.5, 0.7),
+            (-1.0, 0.6),
+            (-1.5, 0.5),
+            (-3.0, 0.5),
+        ] {
+            let mut v = Voice::new();
+            v.step(&F, false, level, 250);
+            assert!(
+                (v.gain(&e, false) - want).abs() < 1e-6,
+                "{level}: {}",
+                v.gain(&e, false)
+            );
+        }
     }
 
     #[test]
