@@ -53,7 +53,8 @@
 //!
 //! - **the gesture's size** ([`Expressive`], [`Voice::gain`]): between decisions the player's
 //!   expression stage ([`crate::player::expression`]) shows the quick part of the motion
-//!   larger when the voice is louder, smaller when it is quieter, and at half size from the
+//!   larger when the voice is louder, smaller when it is quieter (down to half size 15 dB
+//!   under the speaker's level, [`QUIET_SPAN`]), and at half size from the
 //!   first pause step of a silence, so the motion follows the voice within a syllable, not
 //!   only at the next exit point. Resting, a gesture still playing (its cut into a rest waits
 //!   for a pause of its hands, a second or more at the rest's pace) is shown at a quarter of
