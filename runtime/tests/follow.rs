@@ -300,7 +300,7 @@ fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
         silent.iter().any(|a| a.1 == EXPRESSION.caught),
         "{silent:?}"
     );
-    // Back within the span on the speech's first onset.
+    // Back on the speech's first onset.
     let back = (at(6.9)..ticks.len()).find(|&i| ticks[i].onset).unwrap();
     let grown = aims.iter().find(|&&(i, _)| i >= at(6.9)).copied().unwrap();
     assert!(
@@ -308,8 +308,14 @@ fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
         "grown at tick {}, onset {back}",
         grown.0
     );
-    // (The speech out of silence counts as full voice until its first syllable is measured.)
-    assert!((1.0 - EXPRESSION.span..=hi).contains(&grown.1), "{grown:?}");
+    // Growing on the onset's tick, and within the voice's span two ticks later (the heard
+    // loudness rises over 30 ms from the silence's).
+    assert!(grown.1 > EXPRESSION.pause, "{grown:?}");
+    assert!(
+        aims.iter()
+            .any(|&(i, g)| i > back && i <= back + 2 && (1.0 - EXPRESSION.span..=hi).contains(&g)),
+        "{aims:?}"
+    );
     // Without following the voice, the frames as they are.
     let none = run(&samples, VoiceFollow::NONE);
     assert!(none.iter().all(|t| t.gain.is_none()));
