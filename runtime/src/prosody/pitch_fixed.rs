@@ -124,8 +124,12 @@ impl PitchAnalyzerQ {
         self.params = params;
         self.rate = rate_hz as f32;
         self.sizes = sizes;
-        self.threshold =
-            libm::roundf(0.5 * params.voicing_threshold * (1u32 << CORR_BITS) as f32) as i64;
+        // At most 2^32, so that the peak test's threshold times the energy (below 2^30) fits
+        // an i64 whatever a blob says; a threshold that large already passes no peak, as the
+        // f32 analyzer's would (a normalized autocorrelation is at most 1).
+        self.threshold = (libm::roundf(0.5 * params.voicing_threshold * (1u32 << CORR_BITS) as f32)
+            as i64)
+            .min(1 << 32);
         self.silent_ratio = params.silence_threshold / (1.0 + params.voicing_threshold);
         self.log2_range = (libm::log2f(params.floor_hz), libm::log2f(params.ceiling_hz));
         Some(())
@@ -290,6 +294,34 @@ mod tests {
                 assert!((cq.score[bq] - cf.score[bf]).abs() < 0.01, "{freq} {amp}");
                 assert!((cq.score[0] - cf.score[0]).abs() < 1e-3, "{freq} {amp}");
                 assert!(cq.score[bq] > cq.score[0], "{freq} Hz should be voiced");
+            }
+        }
+    }
+
+    #[test]
+    fn any_voicing_threshold_gives_the_f32_analyzer_s_answer_without_overflow() {
+        // Every threshold a blob may hold (finite, not negative), up to the largest f32.
+        for t in [0.0, 0.45, 1.0, 1e6, 1e20, f32::MAX] {
+            let params = PitchParams {
+                voicing_threshold: t,
+                ..PitchParams::PRAAT
+            };
+            let (Some(q), Some(f)) = (
+                PitchAnalyzerQ::new(8000, params),
+                PitchAnalyzer::new(8000, params),
+            ) else {
+                continue;
+            };
+            let n = q.window_len();
+            let (xq, xf) = tone(200.0, 0.9, n);
+            let (mut gq, mut gf) = (GlobalPeak::new(), GlobalPeak::new());
+            let (mut cq, mut cf) = (Candidates::UNVOICED, Candidates::UNVOICED);
+            q.analyze(&xq[..n], &mut gq, &mut cq);
+            f.analyze(&xf[..n], &mut gf, &mut cf);
+            // The same candidates at the same lags.
+            assert_eq!(cq.len, cf.len, "threshold {t}");
+            for i in 1..cq.len {
+                assert!((cq.freq[i] - cf.freq[i]).abs() <= 0.002 * cf.freq[i], "{t}");
             }
         }
     }
