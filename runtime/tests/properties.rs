@@ -6,8 +6,9 @@
 mod common;
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::{BlobController, ControllerEvent};
+use gesture_runtime::controller::{BlobController, Controller, ControllerEvent};
 use gesture_runtime::player::LibraryFrames;
+use gesture_runtime::prosody::arith::{Arith, Fixed, Float};
 use proptest::prelude::*;
 
 fn golden() -> Vec<u8> {
@@ -123,4 +124,101 @@ proptest! {
     fn arbitrary_bytes_never_panic_the_parser(bytes in proptest::collection::vec(any::<u8>(), 0..600)) {
         let _ = Blob::parse(&bytes);
     }
+}
+
+/// Drives a controller with arithmetic `A` over `blob` through a loud tone, silence, noise and
+/// a square wave at full scale; every pose must be finite and within the limits.
+fn drive_arith<A: Arith>(blob: &Blob<'_>) -> Result<usize, String> {
+    let Ok(mut ctl) = Controller::<'_, Blob<'_>, Blob<'_>, A>::from_blob_arith(blob) else {
+        return Ok(0);
+    };
+    let mut samples = Vec::with_capacity(32_000);
+    let mut seed = 0x2545_f491u32;
+    for i in 0..32_000u32 {
+        let t = i as f32 / 16_000.0;
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        samples.push(match i / 8_000 {
+            0 => (30_000.0 * libm::sinf(2.0 * std::f32::consts::PI * 180.0 * t)) as i16,
+            1 => 0,
+            2 => seed as i16,
+            _ if (i / 40) % 2 == 0 => i16::MAX,
+            _ => i16::MIN,
+        });
+    }
+    let (mut poses, mut bad) = (0, None);
+    for c in samples.chunks(160) {
+        ctl.push(c, &mut |e| {
+            if let ControllerEvent::Pose { pose, .. } = e {
+                poses += 1;
+                for (ch, v) in pose.iter().enumerate() {
+                    let (lo, hi, _) = blob.limits(ch);
+                    if !(v.is_finite() && *v >= lo && *v <= hi) {
+                        bad = Some((ch, *v));
+                    }
+                }
+            }
+        });
+    }
+    match bad {
+        Some(b) => Err(format!("pose out of limits: {b:?}")),
+        None => Ok(poses),
+    }
+}
+
+/// Every front-end setting at the extremes the validator may accept (each field in turn, from
+/// zero and the smallest positive float to the largest) either is refused or runs the `f32`
+/// and the integer front-end without overflow, with finite poses within the limits. (A random
+/// mutation once found a voicing threshold large enough to overflow the integer peak test.)
+#[test]
+fn every_front_end_setting_the_validator_accepts_runs_without_overflow() {
+    let values = [
+        0.0,
+        f32::MIN_POSITIVE,
+        1e-30,
+        0.03,
+        0.45,
+        1.0,
+        75.0,
+        1e6,
+        1e30,
+        f32::MAX,
+        -1.0,
+        f32::MIN,
+    ];
+    let mut accepted = 0;
+    for field in 0..11 {
+        for v in values {
+            let mut t = common::Tiny::new();
+            let f = &mut t.front_end;
+            *[
+                &mut f.pitch_floor_hz,
+                &mut f.pitch_ceiling_hz,
+                &mut f.silence_threshold,
+                &mut f.voicing_threshold,
+                &mut f.octave_cost,
+                &mut f.octave_jump_cost,
+                &mut f.voiced_unvoiced_cost,
+                &mut f.margin_db,
+                &mut f.range_db,
+                &mut f.floor_db,
+                &mut f.initial_peak_db,
+            ][field] = v;
+            let bytes = t.encode();
+            let Ok(blob) = Blob::parse(&bytes) else {
+                continue;
+            };
+            accepted += 1;
+            for (arith, r) in [
+                ("f32", drive_arith::<Float>(&blob)),
+                ("fixed", drive_arith::<Fixed>(&blob)),
+            ] {
+                assert!(r.is_ok(), "field {field} = {v:e}, {arith}: {r:?}");
+                assert!(r.unwrap() > 50, "field {field} = {v:e}, {arith}: no poses");
+            }
+        }
+    }
+    // Most fields take most values: the extremes are reached, not all refused.
+    assert!(accepted >= 50, "only {accepted} settings accepted");
 }
