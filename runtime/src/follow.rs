@@ -478,42 +478,7 @@ mod tests {
         assert_eq!(n.take_change(), None);
     }
 
-    struct Energies(&'static [f32]);
-    impl PolicyTables for Energies {
-        fn states(&self) -> usize {
-            1
-        }
-        fn exit_count(&self) -> usize {
-            1
-        }
-        fn exit_segment(&self, _: usize) -> usize {
-            0
-        }
-        fn exit_frame(&self, _: usize) -> usize {
-            0
-        }
-        fn exit_is_end(&self, _: usize) -> bool {
-            true
-        }
-        fn first_exit(&self, _: usize) -> usize {
-            0
-        }
-        fn u(&self, _: usize, _: usize) -> f32 {
-            0.0
-        }
-        fn u_cont(&self, _: usize, _: usize) -> f32 {
-            0.0
-        }
-        fn successor_count(&self, _: usize) -> usize {
-            0
-        }
-        fn successor(&self, _: usize, _: usize) -> (usize, f32) {
-            (0, 0.0)
-        }
-        fn energy(&self, c: usize) -> f32 {
-            self.0[c]
-        }
-    }
+    use crate::testing::Energies;
 
     #[test]
     fn the_rest_rate_slows_what_is_faster_than_a_rest_down_to_half() {

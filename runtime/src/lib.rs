@@ -69,3 +69,5 @@ pub mod rest;
 pub mod rig;
 pub mod rotation;
 pub mod show;
+#[cfg(test)]
+mod testing;

@@ -3,6 +3,7 @@
 
 use super::tests::FnLib;
 use super::*;
+use crate::testing::Energies;
 
 /// A single angle and a rotation group (`Z, Y, X`), both turning 20 degrees per tick in
 /// segment 0; segment 1 holds still where segment 0's fifth frame is.
@@ -80,44 +81,6 @@ fn a_cut_carries_on_no_more_velocity_than_the_cap() {
 }
 
 /// Two segments' energies (the rest set's source): segment 1 the calmer.
-struct Energies;
-
-impl crate::policy::PolicyTables for Energies {
-    fn states(&self) -> usize {
-        1
-    }
-    fn exit_count(&self) -> usize {
-        0
-    }
-    fn exit_segment(&self, _: usize) -> usize {
-        0
-    }
-    fn exit_frame(&self, _: usize) -> usize {
-        0
-    }
-    fn exit_is_end(&self, _: usize) -> bool {
-        true
-    }
-    fn first_exit(&self, _: usize) -> usize {
-        0
-    }
-    fn u(&self, _: usize, _: usize) -> f32 {
-        0.0
-    }
-    fn u_cont(&self, _: usize, _: usize) -> f32 {
-        0.0
-    }
-    fn successor_count(&self, _: usize) -> usize {
-        0
-    }
-    fn successor(&self, _: usize, _: usize) -> (usize, f32) {
-        (0, 0.0)
-    }
-    fn energy(&self, c: usize) -> f32 {
-        [1.0, -1.0][c.min(1)]
-    }
-}
-
 /// Known answer: a cut into a rest segment blends at [`REST_BLEND`] of the speed cap. From 0
 /// to 100 degrees with a cap of 20, a gesture's blend takes `ceil(8.406 * 100 * 2 / (e^2 *
 /// 20)) = 12` ticks; into a rest, at half the cap, 23, no step over 10; back out of the rest
@@ -150,7 +113,7 @@ fn a_cut_into_a_rest_blends_at_a_share_of_the_cap() {
         }
         (most, ticks)
     };
-    let rest = RestSet::of(&Energies, 2);
+    let rest = RestSet::of(&Energies(&[1.0, -1.0]), 2);
     assert_eq!(rest.segments(), &[1]);
     let (_, gesture) = blend(RestSet::EMPTY, 1);
     assert_eq!(gesture, 12 + 1);
