@@ -167,3 +167,57 @@ fn a_baked_run_is_its_show_and_refuses_a_style() {
     );
     refused(&o, &out, "neutral style");
 }
+
+/// Ticks of the decisions and onset times (s) of a run of the blob's controller with `ahead`.
+fn decisions(blob: &Blob<'_>, samples: &[i16], ahead: Lookahead) -> (Vec<f64>, Vec<f64>) {
+    let mut slot = Box::new(None);
+    let c = BlobController::from_blob_in(&mut slot, blob).unwrap();
+    c.set_lookahead(ahead);
+    let fps = blob.fps() as f64;
+    let (mut onsets, mut decided) = (Vec::new(), Vec::new());
+    let mut sink = |e: ControllerEvent<'_>| match e {
+        ControllerEvent::Onset(f) => onsets.push(f as f64 * 0.01),
+        ControllerEvent::Decision { tick, .. } => decided.push(tick as f64 / fps),
+        _ => {}
+    };
+    for ch in samples.chunks(160) {
+        c.push(ch, &mut sink);
+    }
+    c.finish(&mut sink);
+    c.drain(&mut sink);
+    (decided, onsets)
+}
+
+/// With look-ahead an onset counts for decisions from `decision_lead_ms` before its syllable:
+/// decisions then fall in the 100 ms before an onset, which without the lead only a decision
+/// at a segment's end or in a rest does.
+#[test]
+fn look_ahead_decides_a_little_before_the_syllable() {
+    let s = setup();
+    let bytes = std::fs::read(&s.full).unwrap();
+    let blob = Blob::parse(&bytes).unwrap();
+    let pcm = load_wav_at(&s.wav, blob.prosody_config().sample_rate_hz).unwrap();
+    let before = |lead: u32| {
+        let ahead = Lookahead {
+            decision_lead_ms: lead,
+            ..Lookahead::ms(500)
+        };
+        let (decided, onsets) = decisions(&blob, &pcm.samples, ahead);
+        let n = decided
+            .iter()
+            .filter(|&&d| onsets.iter().any(|&o| o > d + 1e-6 && o <= d + 0.1 + 1e-6))
+            .count();
+        (n, decided.len())
+    };
+    let (with, n_with) = before(100);
+    let (without, n_without) = before(0);
+    println!("decisions in the 100 ms before an onset: {with} of {n_with} with the lead, {without} of {n_without} without");
+    assert_eq!(Lookahead::ms(500).decision_lead_ms, 100);
+    assert!(n_with >= 10 && n_without >= 10);
+    // (On this synthetic speech: 20 of 46 against 9 of 37.)
+    let share = |k: usize, n: usize| k as f64 / n as f64;
+    assert!(
+        share(with, n_with) >= share(without, n_without) + 0.1,
+        "{with} of {n_with} against {without} of {n_without}"
+    );
+}

@@ -9,9 +9,12 @@
 //! about 0.09 s late. Three things use it, each at the speech's own time rather than when the
 //! front-end reported it:
 //!
-//! - **Onsets** count for the decisions ([`crate::policy::DecisionTiming`]) at the tick their
-//!   syllable starts, so new gestures start with the syllables rather than a detection delay
-//!   after them.
+//! - **Onsets** count for the decisions ([`crate::policy::DecisionTiming`]) from
+//!   `decision_lead_ms` before the tick their syllable starts, so new gestures start with the
+//!   syllables rather than a detection delay after them. A little before: a cut's blend and
+//!   the new segment's first motion bring the hands' speed to a peak about 0.15-0.2 s after
+//!   the cut, so a decision on the syllable itself put that peak between two syllables; a
+//!   speaker's preparation, too, begins before the syllable its stroke meets.
 //! - **The voice** ([`crate::follow`]: pause steps counting towards rest, the speech's return)
 //!   acts `voice_lead_ms` before the speech does: the hands settle as the pause begins and
 //!   prepare as a speaker's do, just before the first syllable.
@@ -66,6 +69,8 @@ pub struct Lookahead {
     pub voice_lead_ms: u32,
     /// How far a stroke may be moved to meet a syllable onset (ms; 0: strokes are not moved).
     pub stroke_shift_ms: u32,
+    /// How long before its syllable an onset counts for decisions (ms; at most `ms`).
+    pub decision_lead_ms: u32,
 }
 
 impl Lookahead {
@@ -74,12 +79,14 @@ impl Lookahead {
         ms: 0,
         voice_lead_ms: 0,
         stroke_shift_ms: 0,
+        decision_lead_ms: 0,
     };
 
     /// `ms` of look-ahead (clamped to [`MAX_LOOKAHEAD_MS`]) with the default voice lead
-    /// (250 ms) and stroke shift (300 ms: the gap between two syllables at 3-4 per second, so
+    /// (250 ms), stroke shift (300 ms: the gap between two syllables at 3-4 per second, so
     /// nearly every stroke finds one; 200 ms left more strokes off the syllables on tuning
-    /// speech).
+    /// speech) and decision lead (100 ms: on tuning speech the hands' speed followed the
+    /// voice best there, among 0, 50, 100, 150 and 200 ms; docs/method.md).
     pub const fn ms(ms: u32) -> Self {
         let ms = if ms > MAX_LOOKAHEAD_MS {
             MAX_LOOKAHEAD_MS
@@ -90,6 +97,7 @@ impl Lookahead {
             ms,
             voice_lead_ms: 250,
             stroke_shift_ms: 300,
+            decision_lead_ms: 100,
         }
     }
 }
@@ -141,6 +149,8 @@ pub(super) struct Ahead {
     /// Ticks the pace holds after a stroke, and until when it holds.
     steady: u64,
     steady_until: u64,
+    /// Ticks before its syllable an onset counts for decisions.
+    decision_lead: u64,
 }
 
 /// The tick at which 10 ms frame `frame` starts, at `fps_milli` thousandths of a frame per
@@ -170,6 +180,7 @@ impl Ahead {
             slew: 0.0,
             steady: 0,
             steady_until: 0,
+            decision_lead: 0,
         }
     }
 
@@ -179,14 +190,17 @@ impl Ahead {
 
     /// Sets the look-ahead for `rate` Hz and `fps_milli`; what was pending stays pending.
     pub(super) fn set(&mut self, l: Lookahead, rate: u64, fps_milli: u64) {
+        let ms = l.ms.min(MAX_LOOKAHEAD_MS);
         let l = Lookahead {
-            ms: l.ms.min(MAX_LOOKAHEAD_MS),
-            voice_lead_ms: l.voice_lead_ms.min(l.ms.min(MAX_LOOKAHEAD_MS)),
+            ms,
+            voice_lead_ms: l.voice_lead_ms.min(ms),
             stroke_shift_ms: l.stroke_shift_ms.min(MAX_LOOKAHEAD_MS),
+            decision_lead_ms: l.decision_lead_ms.min(ms),
         };
         self.settings = l;
         self.lead_samples = l.ms as u64 * rate / 1000;
         self.voice_lead = ms_ticks(l.voice_lead_ms, fps_milli);
+        self.decision_lead = ms_ticks(l.decision_lead_ms, fps_milli);
         self.shift = if l.ms > 0 {
             ms_ticks(l.stroke_shift_ms, fps_milli)
         } else {
@@ -258,11 +272,15 @@ impl Ahead {
         }
     }
 
-    /// The latest onset due by tick `now` (removing those due).
+    /// The latest onset that counts for decisions by tick `now`: due by `now` (removing those)
+    /// or the next within the decision lead (which stays queued: a stroke may still aim at it).
     pub(super) fn due_onset(&mut self, now: u64) -> Option<u64> {
         let mut last = None;
         while let Some(&t) = self.onsets.front() {
             if t > now {
+                if t <= now + self.decision_lead {
+                    last = Some(t);
+                }
                 break;
             }
             last = Some(t);
@@ -431,9 +449,14 @@ mod tests {
         assert_eq!(ahead.onset(153, 0, FPS_MILLI), (false, false));
         let t = stroke_tick(&mut ahead);
         assert!(t.abs_diff(46) <= 1, "{t}");
-        // The onset counts for decisions at its own tick, the voice hears it 250 ms before.
-        assert_eq!(ahead.due_onset(45), None);
+        // The onset counts for decisions from 100 ms (3 ticks) before its own tick and stays
+        // queued for the strokes until then; the voice hears it 250 ms before.
+        assert_eq!(ahead.due_onset(42), None);
+        assert_eq!(ahead.due_onset(43), Some(46));
+        assert_eq!(ahead.onsets.len(), 1);
         assert_eq!(ahead.due_onset(46), Some(46));
+        assert!(ahead.onsets.is_empty());
+        assert_eq!(ahead.due_onset(47), None);
         let mut early = Ahead::new();
         early.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
         early.onset(153, 0, FPS_MILLI);
