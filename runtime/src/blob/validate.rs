@@ -77,6 +77,12 @@ impl<'a> Iterator for Lines<'a> {
     }
 }
 
+/// Whether `x` is in `codes`: `contains` on bytes links a 338-byte `memchr`.
+#[allow(clippy::manual_contains)]
+fn seen(codes: &[u8], x: u8) -> bool {
+    codes.iter().any(|&y| y == x)
+}
+
 /// [`Lines`] of `s`.
 fn lines(s: &str) -> Lines<'_> {
     Lines(Some(s.as_bytes()))
@@ -658,8 +664,7 @@ fn skeleton(s: &SkeletonSection<'_>, rig_channels: usize) -> Result<(), BlobErro
             || codes
                 .iter()
                 .enumerate()
-                // (`iter().any`, not `contains`: on bytes that links a 338-byte memchr.)
-                .any(|(i, &x)| x > 5 || codes[..i].iter().any(|&y| y == x));
+                .any(|(i, &x)| x > 5 || seen(&codes[..i], x));
         if bad {
             return Err(BlobError::BadJointChannels { joint: k as u32 });
         }
