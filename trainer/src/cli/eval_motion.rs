@@ -35,8 +35,8 @@ pub struct EvalMotionArgs {
     #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=1000))]
     pub random_runs: u64,
     /// Runs of each device method (online and its ablations) to average, the speech delayed
-    /// by 0.2 s more each time and by a share of a 10 ms front-end frame (the variety figures
-    /// are of the first run).
+    /// by 0.2 s more each time and by a share of a 10 ms front-end frame (every figure is the
+    /// mean over the runs, the largest jump the largest of any).
     #[arg(long, default_value_t = crate::evaluate::motion::DEFAULT_DEVICE_RUNS, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub device_runs: u64,
     /// Add a row per look-ahead: the controller fed the audio that many ms before it is played
