@@ -35,7 +35,10 @@ fn refused(path: &Path, want: &str) {
 fn summarizes_a_valid_blob() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("example.blob");
-    let n = write_blob(&path, &OwnedPayload::example());
+    // The example with frames 1 and 4 marked as strokes.
+    let mut p = OwnedPayload::example();
+    p.library = p.library.with_peaks(&[1, 4]);
+    let n = write_blob(&path, &p);
     let out = inspect(&path);
     assert!(
         out.status.success(),
@@ -64,8 +67,9 @@ fn summarizes_a_valid_blob() {
         "policy: 2 segments, 3 exit points (2 end, 1 interruption), 4 successor entries \
          (1.33 per exit point), discount 0.9"
             .to_string(),
-        "library: 2 segments, 6 frames, 1 channels, 30 fps (0.20 s of frames), 1 with a \
-         stroke, 1 labelled, 0 run on into their recorded successor, 0 rotation groups"
+        "library: 2 segments, 6 frames, 1 channels, 30 fps (0.20 s of frames), 2 stroke frames \
+         (aimed at syllables with known audio), 1 labelled (1 with a stroke), 0 run on into \
+         their recorded successor, 0 rotation groups"
             .to_string(),
         "rig: \"example\", PWM period 20000 us, 1 channels: head".to_string(),
         "styles: none (neutral only)".to_string(),

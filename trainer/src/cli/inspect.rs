@@ -142,15 +142,17 @@ pub fn summary(b: &Blob<'_>) -> String {
     let segs: Vec<_> = (0..b.segments()).filter_map(|i| b.segment(i)).collect();
     let _ = writeln!(
         s,
-        "library: {} segments, {} frames, {} channels, {} fps ({:.2} s of frames), {} with a \
-         stroke, {} labelled, {} run on into their recorded successor, {} rotation groups",
+        "library: {} segments, {} frames, {} channels, {} fps ({:.2} s of frames), {} stroke \
+         frames (aimed at syllables with known audio), {} labelled ({} with a stroke), {} run \
+         on into their recorded successor, {} rotation groups",
         b.segments(),
         b.frames(),
         b.channels(),
         short(b.fps()),
         b.frames() as f64 / b.fps() as f64,
-        segs.iter().filter(|x| x.stroke.is_some()).count(),
+        (0..b.frames()).filter(|&f| b.is_peak_frame(f)).count(),
         segs.iter().filter(|x| x.label.is_some()).count(),
+        segs.iter().filter(|x| x.stroke.is_some()).count(),
         continued,
         b.group_count()
     );
