@@ -46,9 +46,12 @@
 //!   ([`MIN_RATE`](crate::player::MIN_RATE)), interpolated between frames: a calm motion at
 //!   half speed reads as breathing and drift, not as slow motion.
 //! - **a tone** the user chose (`policy::Style`) sets the body's energy while speaking: the
-//!   speaking energy weight is scaled by the style's neutral weight (1 by default; 0 under
-//!   `sad=1`), or it would override the tone (on new speech, sad motion kept 0.96 of the
-//!   neutral hand speed; scaled, 0.63). The rest penalty and resting stay the voice's: without
+//!   speaking energy weight is scaled by the style's neutral weight plus the weights of the
+//!   tones that lean energetic ([`energetic_tones`]; 1 by default, 0 under `sad=1`, 1 under
+//!   `active=1`). Under a calm tone it would override the tone (on new speech, sad motion kept
+//!   0.96 of the neutral hand speed; scaled, 0.63); under an energetic one, switching it off
+//!   took away more energy than the tone brought (the energy knob's `energetic=1` moved 0.96x
+//!   as fast as neutral; kept, 1.02x). The rest penalty and resting stay the voice's: without
 //!   the penalty every tone brought the rests into speech.
 //!
 //! - **the gesture's size** ([`Expressive`], [`Voice::gain`]): between decisions the player's
@@ -72,7 +75,7 @@
 //! (among the rest segments too). `VoiceFollow::NONE` gives the paper's rule. All arithmetic is
 //! `f32` on values read from the blob, the same on host and device; the state is a few bytes.
 
-use crate::policy::PolicyTables;
+use crate::policy::{PolicyTables, Style};
 
 /// How the character follows the voice (the blob's `control` section).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -172,6 +175,56 @@ pub fn rest_segments<T: PolicyTables + ?Sized>(
     } else {
         RestSet::EMPTY
     }
+}
+
+/// The tones of `t` that lean energetic (bit `m` for tone `m`, at most 8): their value tables,
+/// less the neutral ones, fall with the segments' energy over the first `segments` segments
+/// and every state (a negative covariance). While speaking, the voice's energy term acts on
+/// the neutral share of the style and on these tones' weights: an energetic tone adds to the
+/// energy loud speech brings, a calm one (sad) is not overridden by it.
+pub fn energetic_tones<T: PolicyTables + ?Sized>(t: &T, segments: usize) -> u8 {
+    let states = t.states();
+    if segments == 0 || states == 0 {
+        return 0;
+    }
+    let mut mean = 0.0;
+    for c in 0..segments {
+        mean += t.energy(c);
+    }
+    mean /= segments as f32;
+    let mut mask = 0u8;
+    for m in 0..t.tones().min(8) {
+        let mut cov = 0.0f32;
+        for c in 0..segments {
+            let de = t.energy(c) - mean;
+            for s in 0..states {
+                cov += (t.tone_u(m, c, s) - t.u(c, s)) * de;
+            }
+        }
+        if cov < 0.0 {
+            mask |= 1 << m;
+        }
+    }
+    mask
+}
+
+/// The share of `style` the voice's energy weight acts on while speaking: its neutral weight
+/// and the weights of the tones of `t` that lean energetic ([`energetic_tones`] over the
+/// first `segments` segments); 1 for the neutral style.
+// Not inlined: it runs once per style change, and the boards' code is near its budget.
+#[inline(never)]
+pub fn voice_share<T: PolicyTables + ?Sized>(t: &T, segments: usize, style: &Style) -> f32 {
+    if style.is_neutral() {
+        return 1.0;
+    }
+    let lean = energetic_tones(t, segments);
+    let mut share = style.neutral();
+    for (m, &w) in style.weights().iter().enumerate() {
+        if m < 8 && lean >> m & 1 == 1 {
+            share += w;
+        }
+    }
+    share
 }
 
 /// The calmest of those, candidates at every exit point while resting: the selector's own
@@ -479,6 +532,61 @@ mod tests {
     }
 
     use crate::testing::Energies;
+
+    /// Two states, four segments of energy -1, 0, 1, 2 and three tones: the first's values
+    /// fall with the energy, the second's rise, the third's are the neutral ones shifted.
+    struct Toned;
+    impl PolicyTables for Toned {
+        fn states(&self) -> usize {
+            2
+        }
+        fn exit_count(&self) -> usize {
+            1
+        }
+        fn exit_segment(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_frame(&self, _: usize) -> usize {
+            0
+        }
+        fn exit_is_end(&self, _: usize) -> bool {
+            true
+        }
+        fn first_exit(&self, _: usize) -> usize {
+            0
+        }
+        fn u(&self, c: usize, s: usize) -> f32 {
+            [0.5, -0.25, 1.0, 0.0][c] + s as f32
+        }
+        fn u_cont(&self, _: usize, _: usize) -> f32 {
+            0.0
+        }
+        fn successor_count(&self, _: usize) -> usize {
+            0
+        }
+        fn successor(&self, _: usize, _: usize) -> (usize, f32) {
+            (0, 0.0)
+        }
+        fn tones(&self) -> usize {
+            3
+        }
+        fn energy(&self, c: usize) -> f32 {
+            c as f32 - 1.0
+        }
+        fn tone_u(&self, m: usize, c: usize, s: usize) -> f32 {
+            let e = self.energy(c);
+            self.u(c, s) + [-0.1 * e, 0.2 * e, 3.0][m]
+        }
+    }
+
+    #[test]
+    fn a_tone_leans_energetic_when_its_values_fall_with_the_energy() {
+        // Tone 0 prefers energetic segments, tone 1 calm ones, tone 2 neither.
+        assert_eq!(energetic_tones(&Toned, 4), 0b001);
+        // No segments, or only one (no spread of energy): none leans either way.
+        assert_eq!(energetic_tones(&Toned, 0), 0);
+        assert_eq!(energetic_tones(&Toned, 1), 0);
+    }
 
     #[test]
     fn the_rest_rate_slows_what_is_faster_than_a_rest_down_to_half() {

@@ -142,6 +142,9 @@ pub struct Controller<
     history: History,
     /// The user's tone weights (neutral by default).
     style: Style,
+    /// The style's share the voice's energy weight acts on while speaking: its neutral
+    /// weight and those of the tones that lean energetic ([`crate::follow::energetic_tones`]).
+    voice_share: f32,
     /// The label being served, and those waiting behind it.
     labels: Labels,
     /// A label not served within this long is dropped (ms; 0: never).
@@ -206,6 +209,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             variety: Variety::NONE,
             history: History::new(),
             style: Style::NEUTRAL,
+            voice_share: 1.0,
             labels: Labels::default(),
             label_timeout_ms: 0,
             held_belief: None,
@@ -681,11 +685,12 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             self.ms_ticks(self.variety.usage_ms),
         );
         // While speaking, a tone the user chose sets the body's energy: the voice's energy
-        // weight acts on the neutral share of the style (all of it by default).
+        // weight acts on the neutral share of the style (all of it by default) and on the
+        // tones that lean energetic.
         let share = if self.voice.resting() {
             1.0
         } else {
-            self.style.neutral()
+            self.voice_share
         };
         penalties.set_voice(
             share * self.voice.weight(&self.follow),

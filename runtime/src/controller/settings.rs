@@ -76,6 +76,8 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             });
         }
         self.style = Style::new(weights)?;
+        self.voice_share =
+            crate::follow::voice_share(self.tables, self.lib.segment_count(), &self.style);
         Ok(())
     }
 
