@@ -47,8 +47,8 @@
 //!   half speed reads as breathing and drift, not as slow motion.
 //! - **a tone** the user chose (`policy::Style`) sets the body's energy while speaking: the
 //!   speaking energy weight is scaled by the style's neutral weight plus the weights of the
-//!   tones that lean energetic ([`energetic_tones`]; 1 by default, 0 under `sad=1`, 1 under
-//!   `active=1`). Under a calm tone it would override the tone (on new speech, sad motion kept
+//!   tones that lean energetic ([`energetic_tones`]; 1 by default, 0 under `sad=1`, 1 under a
+//!   tone that leans energetic, as `active=1` does on the shared libraries). Under a calm tone it would override the tone (on new speech, sad motion kept
 //!   0.96 of the neutral hand speed; scaled, 0.63); under an energetic one, switching it off
 //!   took away more energy than the tone brought (the energy knob's `energetic=1` moved 0.96x
 //!   as fast as neutral; kept, 1.02x). The rest penalty and resting stay the voice's: without
