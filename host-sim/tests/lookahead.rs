@@ -13,9 +13,6 @@ use gesture_trainer::audio::load_wav_at;
 /// library stroke shown (`library.peaks`, the tick it is first shown) the distance (s) to the
 /// nearest syllable onset.
 fn strokes(blob: &Blob<'_>, samples: &[i16], ahead: Lookahead) -> (u64, Vec<f64>) {
-    let mut slot = Box::new(None);
-    let c = BlobController::from_blob_in(&mut slot, blob).unwrap();
-    c.set_lookahead(ahead);
     let fps = blob.fps() as f64;
     let (mut onsets, mut shown, mut ticks) = (Vec::new(), Vec::new(), 0u64);
     let mut last = (usize::MAX, 0);
@@ -36,11 +33,7 @@ fn strokes(blob: &Blob<'_>, samples: &[i16], ahead: Lookahead) -> (u64, Vec<f64>
         }
         _ => {}
     };
-    for ch in samples.chunks(160) {
-        c.push(ch, &mut sink);
-    }
-    c.finish(&mut sink);
-    c.drain(&mut sink);
+    run(blob, samples, ahead, &mut sink);
     let d = shown
         .iter()
         .map(|s| {
@@ -168,11 +161,26 @@ fn a_baked_run_is_its_show_and_refuses_a_style() {
     refused(&o, &out, "neutral style");
 }
 
-/// Ticks of the decisions and onset times (s) of a run of the blob's controller with `ahead`.
-fn decisions(blob: &Blob<'_>, samples: &[i16], ahead: Lookahead) -> (Vec<f64>, Vec<f64>) {
+/// Runs the blob's controller with `ahead` on `samples` in 10 ms chunks to the end, every
+/// event into `sink`.
+fn run(
+    blob: &Blob<'_>,
+    samples: &[i16],
+    ahead: Lookahead,
+    sink: &mut impl FnMut(ControllerEvent<'_>),
+) {
     let mut slot = Box::new(None);
     let c = BlobController::from_blob_in(&mut slot, blob).unwrap();
     c.set_lookahead(ahead);
+    for ch in samples.chunks(160) {
+        c.push(ch, sink);
+    }
+    c.finish(sink);
+    c.drain(sink);
+}
+
+/// Times (s) of the decisions and the onsets of a run of the blob's controller with `ahead`.
+fn decisions(blob: &Blob<'_>, samples: &[i16], ahead: Lookahead) -> (Vec<f64>, Vec<f64>) {
     let fps = blob.fps() as f64;
     let (mut onsets, mut decided) = (Vec::new(), Vec::new());
     let mut sink = |e: ControllerEvent<'_>| match e {
@@ -180,11 +188,7 @@ fn decisions(blob: &Blob<'_>, samples: &[i16], ahead: Lookahead) -> (Vec<f64>, V
         ControllerEvent::Decision { tick, .. } => decided.push(tick as f64 / fps),
         _ => {}
     };
-    for ch in samples.chunks(160) {
-        c.push(ch, &mut sink);
-    }
-    c.finish(&mut sink);
-    c.drain(&mut sink);
+    run(blob, samples, ahead, &mut sink);
     (decided, onsets)
 }
 

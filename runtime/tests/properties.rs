@@ -51,8 +51,20 @@ fn drive_styled(
     if ctl.set_style(weights).is_err() {
         prop_assert!(ctl.style().is_neutral());
     }
-    let mut poses = 0;
-    let mut bad = None;
+    let (poses, bad) = push_checked(&mut ctl, &blob, samples, chunk);
+    prop_assert!(bad.is_none(), "pose out of limits: {bad:?}");
+    Ok(poses)
+}
+
+/// Pushes `samples` into `ctl` in `chunk`-sized pieces; the poses played and the last channel
+/// and value that was not finite or outside the blob's limits, if any.
+fn push_checked<A: Arith>(
+    ctl: &mut Controller<'_, Blob<'_>, Blob<'_>, A>,
+    blob: &Blob<'_>,
+    samples: &[i16],
+    chunk: usize,
+) -> (usize, Option<(usize, f32)>) {
+    let (mut poses, mut bad) = (0, None);
     for c in samples.chunks(chunk.max(1)) {
         ctl.push(c, &mut |e| {
             if let ControllerEvent::Pose { pose, .. } = e {
@@ -66,8 +78,7 @@ fn drive_styled(
             }
         });
     }
-    prop_assert!(bad.is_none(), "pose out of limits: {bad:?}");
-    Ok(poses)
+    (poses, bad)
 }
 
 proptest! {
@@ -147,23 +158,9 @@ fn drive_arith<A: Arith>(blob: &Blob<'_>) -> Result<usize, String> {
             _ => i16::MIN,
         });
     }
-    let (mut poses, mut bad) = (0, None);
-    for c in samples.chunks(160) {
-        ctl.push(c, &mut |e| {
-            if let ControllerEvent::Pose { pose, .. } = e {
-                poses += 1;
-                for (ch, v) in pose.iter().enumerate() {
-                    let (lo, hi, _) = blob.limits(ch);
-                    if !(v.is_finite() && *v >= lo && *v <= hi) {
-                        bad = Some((ch, *v));
-                    }
-                }
-            }
-        });
-    }
-    match bad {
-        Some(b) => Err(format!("pose out of limits: {b:?}")),
-        None => Ok(poses),
+    match push_checked(&mut ctl, blob, &samples, 160) {
+        (_, Some(b)) => Err(format!("pose out of limits: {b:?}")),
+        (poses, None) => Ok(poses),
     }
 }
 
