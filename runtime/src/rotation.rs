@@ -104,7 +104,9 @@ impl Real for f32 {
         libm::atan2f(self, x)
     }
     fn asin(self) -> Self {
-        libm::asinf(self)
+        // As `atan2`, not `libm::asinf`: that one works in `f64` inside and links the
+        // software double routines on a single-precision FPU.
+        libm::atan2f(self, libm::sqrtf((1.0 - self) * (1.0 + self)))
     }
     fn acos(self) -> Self {
         libm::acosf(self)

@@ -23,16 +23,16 @@ const ODD: usize = CENTRE.div_ceil(2);
 
 /// The half-band design: the windowed-sinc taps at odd offsets 1, 3, ..., 15 from the centre
 /// and the scale that gives unity gain at DC (`1/2 + 2 * scale * sum(taps) = 1`).
-fn design() -> ([f64; ODD], f64) {
-    let mut taps = [0.0f64; ODD];
-    let mut sum = 0.0f64;
+fn design() -> ([f32; ODD], f32) {
+    let mut taps = [0.0f32; ODD];
+    let mut sum = 0.0f32;
     for (m, c) in taps.iter_mut().enumerate() {
-        let k = (2 * m + 1) as f64;
+        let k = (2 * m + 1) as f32;
         // sin(pi k / 2) for odd k = 2m + 1 is (-1)^m.
         let sign = if m % 2 == 0 { 1.0 } else { -1.0 };
-        let sinc = sign / (core::f64::consts::PI * k);
+        let sinc = sign / (core::f32::consts::PI * k);
         // Blackman window over 32 points so that the outermost taps are not zero.
-        let phase = 2.0 * core::f64::consts::PI * k / (TAPS as f64 + 1.0);
+        let phase = 2.0 * core::f32::consts::PI * k / (TAPS as f32 + 1.0);
         let w = 0.42
             + 0.5 * super::frame::window_cos(phase)
             + 0.08 * super::frame::window_cos(2.0 * phase);
@@ -63,7 +63,7 @@ impl HalfBand {
         let (taps, scale) = design();
         let mut coef = [0.0f32; ODD];
         for (c, &h) in coef.iter_mut().zip(taps.iter()) {
-            *c = ((h as f32) as f64 * scale) as f32;
+            *c = h * scale;
         }
         Self {
             coef,
@@ -183,7 +183,7 @@ impl HalfBandQ {
         let one = 1i32 << COEF_BITS;
         let mut coef = [0i32; ODD];
         for (c, &h) in coef.iter_mut().zip(taps.iter()) {
-            *c = libm::round(h * scale * one as f64) as i32;
+            *c = libm::roundf(h * scale * one as f32) as i32;
         }
         // Unity gain at DC exactly: one/2 + 2 sum(coef) = one (the error lands on the
         // largest tap, where it is relatively smallest).

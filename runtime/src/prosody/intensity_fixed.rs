@@ -104,7 +104,7 @@ impl IntensityQ {
         for (w, v) in self.weights.iter_mut().zip(weights) {
             // At least 1: a tail weight rounded to 0 would make a window whose only change
             // lies in its tails silent (-300 dB) where the f32 path and Praat see a level.
-            *w = (libm::round(v * (1u32 << WEIGHT_BITS) as f64) as u32).max(1);
+            *w = (libm::roundf(v * (1u32 << WEIGHT_BITS) as f32) as u32).max(1);
             sum += 2 * *w as i64;
         }
         let block_len = rate_hz / 1000;
@@ -115,7 +115,7 @@ impl IntensityQ {
         self.blocks = 0;
         self.cur = Block::EMPTY;
         self.cur_n = 0;
-        self.scale = (1.0 / (32768.0f64 * 32768.0 * 4.0e-10)) as f32;
+        self.scale = 1.0 / (32768.0f32 * 32768.0 * 4.0e-10);
         Some(())
     }
 

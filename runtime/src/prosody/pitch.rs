@@ -202,8 +202,8 @@ impl PitchAnalyzer {
         } = Sizes::new(rate_hz, &params)?;
         self.hann.fill(0.0);
         for (i, h) in self.hann.iter_mut().take(window_len).enumerate() {
-            let phase = (i + 1) as f64 * 2.0 * core::f64::consts::PI / (window_len + 1) as f64;
-            *h = (0.5 - 0.5 * super::frame::window_cos(phase)) as f32;
+            let phase = (i + 1) as f32 * 2.0 * core::f32::consts::PI / (window_len + 1) as f32;
+            *h = 0.5 - 0.5 * super::frame::window_cos(phase);
         }
         self.params = params;
         self.rate = rate;

@@ -94,11 +94,11 @@ impl PitchAnalyzerQ {
         let sizes = Sizes::new(rate_hz, &params)?;
         let n = sizes.window_len;
         self.hann.fill(0);
-        let one = (1i32 << HANN_BITS) as f64;
+        let one = (1i32 << HANN_BITS) as f32;
         for (i, h) in self.hann.iter_mut().take(n).enumerate() {
-            let phase = (i + 1) as f64 * 2.0 * core::f64::consts::PI / (n + 1) as f64;
+            let phase = (i + 1) as f32 * 2.0 * core::f32::consts::PI / (n + 1) as f32;
             let v = (0.5 - 0.5 * super::frame::window_cos(phase)) * one;
-            *h = libm::round(v).min(i16::MAX as f64) as i16;
+            *h = libm::roundf(v).min(i16::MAX as f32) as i16;
         }
         // The window's autocorrelation, exactly, from the same table.
         let lag_sum = |lag: usize| -> i64 {
