@@ -125,5 +125,13 @@ pub fn run(a: &EvalMotionArgs) -> Result<(), CliError> {
             None => outln!("  {:<16} {:>3} run", r.method, r.runs)?,
         }
     }
+    if let Some(d) = ev.online_minus_prior {
+        outln!(
+            "online less online_prior in coupling, run by run: {:+.3} +-{:.3} (standard error, {} runs)",
+            d.mean,
+            d.se,
+            d.runs
+        )?;
+    }
     Ok(())
 }

@@ -192,11 +192,43 @@ fn spread(runs: &[MotionMetrics]) -> Option<Spread> {
     })
 }
 
+/// A paired difference over runs: the mean of `a[k] - b[k]` and its standard error.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct Paired {
+    /// Mean difference.
+    pub mean: f64,
+    /// Its standard error (the differences' sample standard deviation over the root of the
+    /// runs).
+    pub se: f64,
+    /// Pairs.
+    pub runs: usize,
+}
+
+/// The paired difference of `a` and `b` run by run (`None` with fewer than two pairs).
+pub fn paired(a: &[f64], b: &[f64]) -> Option<Paired> {
+    let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
+    if d.len() < 2 {
+        return None;
+    }
+    let n = d.len() as f64;
+    let mean = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    Some(Paired {
+        mean,
+        se: (var / n).sqrt(),
+        runs: d.len(),
+    })
+}
+
 /// An evaluation's result.
 #[derive(Debug, Clone, Serialize)]
 pub struct Evaluation {
     /// One row per method.
     pub rows: Vec<Row>,
+    /// Speech coupling online less with the belief held at the prior, run by run (the same
+    /// delay in both): what the belief adds, and whether that is more than the runs' noise
+    /// (`None` with one run).
+    pub online_minus_prior: Option<Paired>,
     /// Library segments.
     pub library_segments: usize,
     /// Online decisions.
@@ -409,6 +441,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     let step = ((PHASE_STEP_S * fps).round() as usize).max(1);
     let prior: Vec<f32> = model.state_prior.iter().map(|&v| v as f32).collect();
     let mut made = Vec::new();
+    let (mut online_coupling, mut prior_coupling) = (Vec::new(), Vec::new());
     for method in [
         Ablation::None,
         Ablation::Pure,
@@ -440,6 +473,12 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
                 made = m;
             }
             ms.push(measured(&p)?);
+        }
+        let coupling = ms.iter().map(|m| m.speech_coupling).collect();
+        match method {
+            Ablation::None => online_coupling = coupling,
+            Ablation::Prior => prior_coupling = coupling,
+            _ => {}
         }
         rows.push(Row::of_runs(method.name(), &ms));
     }
@@ -518,6 +557,7 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     progress.finish_and_clear();
     Ok(Evaluation {
         rows,
+        online_minus_prior: paired(&online_coupling, &prior_coupling),
         library_segments: segments,
         decisions: made.len(),
         variety_regret: excess / best_total.max(1e-12),
@@ -532,6 +572,18 @@ mod tests {
     /// Device runs and random runs are averaged figure by figure (the speech coupling and the
     /// variety figures included; counts to the nearest whole), and the largest jump is the
     /// largest of any run.
+    #[test]
+    fn a_paired_difference_is_the_mean_difference_and_its_standard_error() {
+        // Differences 0.5, 0.5, -0.5: mean 1/6, sample deviation sqrt(1/3), error 1/3.
+        let d = paired(&[1.0, 2.0, 3.0], &[0.5, 1.5, 3.5]).unwrap();
+        assert!((d.mean - 1.0 / 6.0).abs() < 1e-12);
+        assert!((d.se - 1.0 / 3.0).abs() < 1e-12);
+        assert_eq!(d.runs, 3);
+        // A constant difference has no error; one pair has no estimate.
+        assert_eq!(paired(&[2.0, 3.0], &[1.0, 2.0]).unwrap().se, 0.0);
+        assert_eq!(paired(&[1.0], &[0.0]), None);
+    }
+
     #[test]
     fn runs_average_every_figure_and_keep_the_largest_jump() {
         let a = MotionMetrics {
