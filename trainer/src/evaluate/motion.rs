@@ -174,14 +174,20 @@ impl Row {
     }
 }
 
-/// Sample standard deviation of `f` over `runs` (`None` with fewer than two runs).
-fn sd(runs: &[MotionMetrics], f: impl Fn(&MotionMetrics) -> Option<f64>) -> Option<f64> {
-    let v: Vec<f64> = runs.iter().map(f).collect::<Option<_>>()?;
+/// Mean and sample standard deviation of `v` (`None` with fewer than two values).
+fn mean_sd(v: &[f64]) -> Option<(f64, f64)> {
     if v.len() < 2 {
         return None;
     }
     let m = v.iter().sum::<f64>() / v.len() as f64;
-    Some((v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt())
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+    Some((m, var.sqrt()))
+}
+
+/// Sample standard deviation of `f` over `runs` (`None` with fewer than two runs).
+fn sd(runs: &[MotionMetrics], f: impl Fn(&MotionMetrics) -> Option<f64>) -> Option<f64> {
+    let v: Vec<f64> = runs.iter().map(f).collect::<Option<_>>()?;
+    mean_sd(&v).map(|(_, s)| s)
 }
 
 fn spread(runs: &[MotionMetrics]) -> Option<Spread> {
@@ -207,15 +213,10 @@ pub struct Paired {
 /// The paired difference of `a` and `b` run by run (`None` with fewer than two pairs).
 pub fn paired(a: &[f64], b: &[f64]) -> Option<Paired> {
     let d: Vec<f64> = a.iter().zip(b).map(|(x, y)| x - y).collect();
-    if d.len() < 2 {
-        return None;
-    }
-    let n = d.len() as f64;
-    let mean = d.iter().sum::<f64>() / n;
-    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let (mean, sd) = mean_sd(&d)?;
     Some(Paired {
         mean,
-        se: (var / n).sqrt(),
+        se: sd / (d.len() as f64).sqrt(),
         runs: d.len(),
     })
 }
@@ -569,9 +570,6 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
 mod tests {
     use super::*;
 
-    /// Device runs and random runs are averaged figure by figure (the speech coupling and the
-    /// variety figures included; counts to the nearest whole), and the largest jump is the
-    /// largest of any run.
     #[test]
     fn a_paired_difference_is_the_mean_difference_and_its_standard_error() {
         // Differences 0.5, 0.5, -0.5: mean 1/6, sample deviation sqrt(1/3), error 1/3.
@@ -584,6 +582,9 @@ mod tests {
         assert_eq!(paired(&[1.0], &[0.0]), None);
     }
 
+    /// Device runs and random runs are averaged figure by figure (the speech coupling and the
+    /// variety figures included; counts to the nearest whole), and the largest jump is the
+    /// largest of any run.
     #[test]
     fn runs_average_every_figure_and_keep_the_largest_jump() {
         let a = MotionMetrics {
