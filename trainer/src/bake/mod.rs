@@ -7,6 +7,8 @@
 //! - [`timeline`]: the belief, the voice and the onsets at every tick, from the runtime's own
 //!   front-end, normalizer, belief and voice rule run over the audio;
 //! - [`plan`]: the dynamic program;
+//! - [`variety`]: the whole run's variety lines (no segment over 15 %, half the library
+//!   played) as prices on the plan, raised until it meets them (dual ascent);
 //! - [`bake`]: both, and the plan as the player's commands ([`Baked::commands`]), with a rest
 //!   held until the speech returns played to and fro as the live controller plays it;
 //! - [`Baked::show`] and [`Baked::play`]: the show file and its poses
@@ -18,6 +20,7 @@
 mod error;
 pub mod plan;
 pub mod timeline;
+pub mod variety;
 
 pub use error::BakeError;
 
@@ -31,6 +34,8 @@ use gesture_runtime::show::{encode, Show, ShowPlayer};
 
 pub use plan::{Act, Planned, Weights};
 pub use timeline::Timeline;
+use variety::PRICE_ROUNDS;
+pub use variety::{Played, Prices, DISTINCT_MIN, SHARE_CAP};
 
 /// A baked run.
 #[derive(Clone, Debug)]
@@ -78,28 +83,23 @@ pub fn bake_with(blob: &Blob<'_>, samples: &[i16], w: &Weights) -> Result<Baked,
     let ticks = ticks_of(samples.len(), rate, fps_milli);
     let tl = Timeline::of(blob, samples, ticks as usize)?;
     let segments = LibraryFrames::segment_count(blob);
-    // The variety line "no segment over 15 % of the run" as a constraint: a price per tick
-    // played on every segment over the cap, raised until none is (dual ascent); the plan
-    // with the smallest largest share is kept.
-    let mut prices = vec![0.0f32; segments];
-    let mut kept: Option<(f32, Vec<Planned>, f32)> = None;
+    // The variety lines as constraints (dual ascent, see `variety`); the plan nearest them
+    // is kept.
+    let mut prices = Prices::new(segments);
+    let mut kept: Option<((f32, f32), Vec<Planned>, f32)> = None;
     for _ in 0..PRICE_ROUNDS {
-        let (plan, cost) = plan::plan(blob, &tl, w, &prices);
-        let shares = shares(&plan, ticks, segments);
-        let largest = shares.iter().copied().fold(0.0f32, f32::max);
-        if kept.as_ref().is_none_or(|k| largest < k.0) {
-            kept = Some((largest, plan, cost));
+        let (plan, cost) = plan::plan(blob, &tl, w, &prices.per_segment());
+        let played = Played::of(&plan, ticks, segments);
+        let violation = played.violation();
+        if kept.as_ref().is_none_or(|k| violation < k.0) {
+            kept = Some((violation, plan, cost));
         }
-        if largest <= SHARE_CAP {
+        if violation == (0.0, 0.0) {
             break;
         }
-        for (p, &sh) in prices.iter_mut().zip(&shares) {
-            if sh > SHARE_CAP {
-                *p += PRICE_STEP * (sh - SHARE_CAP) / SHARE_CAP;
-            }
-        }
+        prices.raise(&played);
     }
-    let (_, plan, cost) = kept.unwrap_or((0.0, Vec::new(), 0.0));
+    let (_, plan, cost) = kept.unwrap_or(((0.0, 0.0), Vec::new(), 0.0));
     let commands = commands(blob, &plan, ticks, &tl.gain);
     Ok(Baked {
         plan,
@@ -107,39 +107,6 @@ pub fn bake_with(blob: &Blob<'_>, samples: &[i16], w: &Weights) -> Result<Baked,
         commands,
         ticks,
     })
-}
-
-/// The largest share of the run a plan may give one segment: the variety line (15 %) less a
-/// margin for the ticks a blend adds.
-pub const SHARE_CAP: f32 = 0.14;
-/// How much a segment's price rises per unit of its share over the cap (relative).
-const PRICE_STEP: f32 = 1.0;
-/// Most plans made while raising prices.
-const PRICE_ROUNDS: usize = 8;
-
-/// Each segment's share of the `ticks` ticks a plan plays (a segment plays from the
-/// decision that enters it to the next that leaves it; before the first, segment 0).
-fn shares(plan: &[Planned], ticks: u64, segments: usize) -> Vec<f32> {
-    let mut played = vec![0u64; segments];
-    let (mut seg, mut from) = (0usize, 0u64);
-    for d in plan {
-        let next = match d.act {
-            Act::Continue { .. } | Act::Hold => continue,
-            Act::Enter { segment, .. } | Act::Rest { segment } => segment,
-        };
-        if let Some(p) = played.get_mut(seg) {
-            *p += d.tick.min(ticks).saturating_sub(from);
-        }
-        seg = next;
-        from = d.tick.min(ticks);
-    }
-    if let Some(p) = played.get_mut(seg) {
-        *p += ticks.saturating_sub(from);
-    }
-    played
-        .iter()
-        .map(|&p| p as f32 / ticks.max(1) as f32)
-        .collect()
 }
 
 /// The player's commands that carry out `plan` over `ticks` ticks: each decision's after the

@@ -151,7 +151,8 @@ struct Cell {
 const NONE: u32 = u32::MAX;
 
 /// The plan over `tl` for `blob` and its total cost; `prices[c]` (cost units per mean
-/// interval between exit points, empty: none) is charged for every tick segment `c` plays.
+/// interval between exit points, empty: none; a negative price is a prize) is charged for
+/// every tick segment `c` plays.
 pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec<Planned>, f32) {
     let t_end = tl.ticks;
     let exits = PolicyTables::exit_count(blob);

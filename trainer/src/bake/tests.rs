@@ -224,33 +224,6 @@ fn a_rest_is_left_by_a_cut_and_a_segment_end_runs_on() {
     );
 }
 
-/// Shares of a plan, counted by hand: segment 0 until tick 10, segment 1 (continued at 20)
-/// until 60, segment 2 to the end (100 ticks).
-#[test]
-fn shares_count_each_segment_from_its_entry_to_the_next() {
-    let d = |tick, act| Planned {
-        tick,
-        exit: 0,
-        act,
-        until: 0,
-        candidates: 1,
-        cost: 0.0,
-    };
-    let plan = [
-        d(
-            10,
-            Act::Enter {
-                segment: 1,
-                rate: 1.0,
-            },
-        ),
-        d(20, Act::Continue { rate: 0.9 }),
-        d(60, Act::Rest { segment: 2 }),
-    ];
-    let s = shares(&plan, 100, 3);
-    assert_eq!(s, vec![0.1, 0.5, 0.4]);
-}
-
 /// Tick `k` is due at `ceil(k * rate * 1000 / fps_milli)` samples: one second at 16 kHz and
 /// 30 fps holds ticks 0..=30; one sample less, 0..=29.
 #[test]
@@ -259,4 +232,30 @@ fn ticks_of_counts_the_ticks_due() {
     assert_eq!(ticks_of(15_999, 16_000, 30_000), 30);
     assert_eq!(ticks_of(0, 16_000, 30_000), 1);
     assert_eq!(ticks_of(100, 0, 30_000), 0);
+}
+
+/// The synthetic library has 88 segments and the first take's speech room for about 50
+/// entries. Planned with no prices, the file plays under a third of the library (the live
+/// costs only discourage repeats); baked, the variety lines' prices bring it to half, with no
+/// segment over the cap.
+#[test]
+fn the_bake_plays_half_the_library_where_the_speech_has_room() {
+    let (bytes, speech) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let rate = blob.prosody_config().sample_rate_hz;
+    let fps_milli = (blob.fps() * 1000.0).round() as u64;
+    let ticks = ticks_of(speech.len(), rate, fps_milli);
+    let tl = Timeline::of(&blob, &speech, ticks as usize).unwrap();
+    let n = LibraryFrames::segment_count(&blob);
+    let (free, _) = plan::plan(&blob, &tl, &Weights::default(), &vec![0.0; n]);
+    let free = Played::of(&free, ticks, n);
+    assert_eq!(free.distinct_target(), DISTINCT_MIN, "{free:?}");
+    assert!(free.distinct() < 0.4, "the free plan: {}", free.distinct());
+    let baked = Played::of(&bake(&blob, &speech).unwrap().plan, ticks, n);
+    assert!(
+        baked.distinct() >= DISTINCT_MIN,
+        "baked: {}",
+        baked.distinct()
+    );
+    assert!(baked.largest() <= SHARE_CAP, "baked: {}", baked.largest());
 }
