@@ -436,7 +436,7 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
 /// against its own capture), the plan meets the variety lines of the whole run (half the
 /// library or more, no segment over 15 %, no repeats within 5 s over a tenth), rests in the
 /// pauses, and follows the speech at least as well as the capture: coupling 0.9x or more,
-/// strokes on syllables as often (measured +0.575 and +0.249 against the capture's +0.450
+/// strokes on syllables as often (measured +0.630 and +0.251 against the capture's +0.450
 /// and +0.170, 51 % of the library; 41 % before the plan was asked for half).
 #[test]
 fn the_whole_file_plan_varies_and_follows_the_speech_on_another_take() {
