@@ -147,6 +147,15 @@ fn fit_model(corpus: &std::path::Path, span: &str, model: &std::path::Path) {
     gesture_trainer::cli::fit::run(&fit.args).unwrap();
 }
 
+/// A model fitted on the 9-joint take's first 90 s (in `nine`), in a folder that lives as
+/// long as the returned guard.
+fn nine_joint_model(nine: &std::path::Path) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("model.json");
+    fit_model(nine, "0:90", &model);
+    (dir, model)
+}
+
 /// `eval-motion --model MODEL --library LIBRARY... EXTRA...` with the command line's defaults.
 fn eval_motion(
     model: &std::path::Path,
@@ -163,6 +172,24 @@ fn eval_motion(
     argv.extend(library.iter().map(|p| p.as_os_str()));
     argv.extend(extra);
     gesture_trainer::cli::eval_motion::evaluate(&EvalCli::parse_from(argv).args).unwrap()
+}
+
+/// [`eval_motion`] of `library` on a recording's speech against its capture (`speech`: the
+/// WAV and BVH files), with `extra` flags.
+fn eval_with_capture(
+    model: &std::path::Path,
+    library: &std::path::Path,
+    speech: (&std::path::Path, &std::path::Path),
+    extra: &[&str],
+) -> gesture_trainer::evaluate::motion::Evaluation {
+    let mut argv: Vec<&std::ffi::OsStr> = vec![
+        "--audio".as_ref(),
+        speech.0.as_os_str(),
+        "--mocap".as_ref(),
+        speech.1.as_os_str(),
+    ];
+    argv.extend(extra.iter().map(std::ffi::OsStr::new));
+    eval_motion(model, &[library.to_path_buf()], &argv)
 }
 
 /// The metrics of one method's row.
@@ -291,23 +318,10 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
     let Some(bandai) = e2e_tests::shared_data(test, "bandai-namco-gestures") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("model.json");
-    fit_model(&nine, "0:90", &model);
+    let (_dir, model) = nine_joint_model(&nine);
     let wav = nine.join("001_Neutral_0_x_1_0.wav");
     let bvh = nine.join("001_Neutral_0_x_1_0.bvh");
-    let own = eval_motion(
-        &model,
-        std::slice::from_ref(&nine),
-        &[
-            "--audio".as_ref(),
-            wav.as_os_str(),
-            "--mocap".as_ref(),
-            bvh.as_os_str(),
-            "--span".as_ref(),
-            "90:121".as_ref(),
-        ],
-    );
+    let own = eval_with_capture(&model, &nine, (&wav, &bvh), &["--span", "90:121"]);
     let coupling = |m: &str| row(&own, m).speech_coupling;
     let (online, mocap) = (row(&own, "online"), row(&own, "mocap"));
     eprintln!("9-joint 90-121 s: online {online:?}\nmocap {mocap:?}");
@@ -441,33 +455,28 @@ fn online_controller_follows_the_speech_and_varies_on_the_9_joint_take_and_banda
 #[test]
 fn the_whole_file_plan_varies_and_follows_the_speech_on_another_take() {
     let test = "the_whole_file_plan_varies_and_follows_the_speech_on_another_take";
-    let Some(ze) = e2e_tests::shared_data(test, "zeroeggs-067-speech2") else {
+    let (Some(ze), Some(nine)) = (
+        e2e_tests::shared_data(test, "zeroeggs-067-speech2"),
+        e2e_tests::shared_data(test, "zeroeggs-001-neutral-9joint"),
+    ) else {
         return;
     };
-    let Some(nine) = e2e_tests::shared_data(test, "zeroeggs-001-neutral-9joint") else {
-        return;
-    };
-    let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("model.json");
-    fit_model(&nine, "0:90", &model);
+    let (_dir, model) = nine_joint_model(&nine);
     let (wav, bvh) = (
         ze.join("067_Speech_2_first50s.wav"),
         ze.join("067_Speech_2_first50s.bvh"),
     );
-    let eval = eval_motion(
+    let eval = eval_with_capture(
         &model,
-        std::slice::from_ref(&nine),
+        &nine,
+        (&wav, &bvh),
         &[
-            "--audio".as_ref(),
-            wav.as_os_str(),
-            "--mocap".as_ref(),
-            bvh.as_os_str(),
-            "--device-runs".as_ref(),
-            "1".as_ref(),
-            "--random-runs".as_ref(),
-            "1".as_ref(),
-            "--lookahead-ms".as_ref(),
-            "all".as_ref(),
+            "--device-runs",
+            "1",
+            "--random-runs",
+            "1",
+            "--lookahead-ms",
+            "all",
         ],
     );
     let (plan, mocap) = (row(&eval, "lookahead_all"), row(&eval, "mocap"));

@@ -38,6 +38,14 @@ fn blob_and_speech() -> (Vec<u8>, Vec<i16>) {
     (packed.bytes, speech)
 }
 
+/// The ticks `speech` spans for `blob` and its timeline.
+fn timeline(blob: &Blob<'_>, speech: &[i16]) -> (u64, Timeline) {
+    let rate = blob.prosody_config().sample_rate_hz;
+    let fps_milli = (blob.fps() * 1000.0).round() as u64;
+    let ticks = ticks_of(speech.len(), rate, fps_milli);
+    (ticks, Timeline::of(blob, speech, ticks as usize).unwrap())
+}
+
 /// How much the pose changes from tick `k - 1` to tick `k` (degrees, summed over channels).
 fn pose_step(poses: &[BakedPose], k: usize) -> f64 {
     poses[k]
@@ -118,10 +126,8 @@ fn a_baked_run_rests_in_a_silence() {
 fn the_stroke_term_lands_strokes_on_onsets() {
     let (bytes, speech) = blob_and_speech();
     let blob = Blob::parse(&bytes).unwrap();
-    let rate = blob.prosody_config().sample_rate_hz;
+    let (_, tl) = timeline(&blob, &speech);
     let fps_milli = (blob.fps() * 1000.0).round() as u64;
-    let ticks = ticks_of(speech.len(), rate, fps_milli);
-    let tl = Timeline::of(&blob, &speech, ticks as usize).unwrap();
     assert!(tl.onsets.len() >= 20, "{} onsets", tl.onsets.len());
     let with = bake(&blob, &speech).unwrap().play(&blob).unwrap();
     let off = Weights {
@@ -242,10 +248,7 @@ fn ticks_of_counts_the_ticks_due() {
 fn the_bake_plays_half_the_library_where_the_speech_has_room() {
     let (bytes, speech) = blob_and_speech();
     let blob = Blob::parse(&bytes).unwrap();
-    let rate = blob.prosody_config().sample_rate_hz;
-    let fps_milli = (blob.fps() * 1000.0).round() as u64;
-    let ticks = ticks_of(speech.len(), rate, fps_milli);
-    let tl = Timeline::of(&blob, &speech, ticks as usize).unwrap();
+    let (ticks, tl) = timeline(&blob, &speech);
     let n = LibraryFrames::segment_count(&blob);
     let (free, _) = plan::plan(&blob, &tl, &Weights::default(), &vec![0.0; n]);
     let free = Played::of(&free, ticks, n);
