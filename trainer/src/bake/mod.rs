@@ -34,7 +34,7 @@ use gesture_runtime::show::{encode, Show, ShowPlayer};
 
 pub use plan::{Act, Planned, Weights};
 pub use timeline::Timeline;
-use variety::PRICE_ROUNDS;
+use variety::price_rounds;
 pub use variety::{Played, Prices, DISTINCT_MIN, SHARE_CAP};
 
 /// A baked run.
@@ -87,7 +87,7 @@ pub fn bake_with(blob: &Blob<'_>, samples: &[i16], w: &Weights) -> Result<Baked,
     // is kept.
     let mut prices = Prices::new(segments);
     let mut kept: Option<((f32, f32), Vec<Planned>, f32)> = None;
-    for _ in 0..PRICE_ROUNDS {
+    for _ in 0..price_rounds(ticks) {
         let (plan, cost) = plan::plan(blob, &tl, w, &prices.per_segment());
         let played = Played::of(&plan, ticks, segments);
         let violation = played.violation();

@@ -26,8 +26,23 @@ pub const DISTINCT_MIN: f32 = 0.5;
 const PRICE_STEP: f32 = 1.0;
 /// How much an unplayed segment's prize rises per unit of the distinct shortfall (relative).
 const PRIZE_STEP: f32 = 2.0;
-/// Most plans made while raising prices.
+/// Plans made while raising prices, for a run of two minutes or more.
 pub const PRICE_ROUNDS: usize = 8;
+/// Most plans made for a shorter run.
+pub const MAX_PRICE_ROUNDS: usize = 16;
+/// The ticks of two minutes at 30 frames per second: the run whose [`PRICE_ROUNDS`] plans set
+/// the planning work allowed.
+const BUDGET_TICKS: u64 = 3600;
+
+/// How many plans the ascent may make for a run of `ticks` ticks: as many as the work of
+/// [`PRICE_ROUNDS`] plans of two minutes allows (a plan's work grows with its ticks), from
+/// [`PRICE_ROUNDS`] to [`MAX_PRICE_ROUNDS`]. A short run's ascent, which meets the lines
+/// less easily (one long pause is a large share of ten seconds), gets more plans for the same
+/// time.
+pub fn price_rounds(ticks: u64) -> usize {
+    let allowed = PRICE_ROUNDS as u64 * BUDGET_TICKS / ticks.max(1);
+    allowed.clamp(PRICE_ROUNDS as u64, MAX_PRICE_ROUNDS as u64) as usize
+}
 
 /// What a plan plays: each segment's share of the run, and how many segment entries it makes
 /// (the first segment, played from the start, counts as one).
@@ -167,6 +182,17 @@ mod tests {
 
     fn enter(tick: u64, segment: usize) -> Planned {
         planned(tick, Act::Enter { segment, rate: 1.0 })
+    }
+
+    /// Two minutes or more at 30 fps: 8 plans; one minute: 16; ten seconds: 16 (the most).
+    #[test]
+    fn a_short_run_gets_more_plans_for_the_same_work() {
+        assert_eq!(price_rounds(3600), 8);
+        assert_eq!(price_rounds(7200), 8);
+        assert_eq!(price_rounds(2400), 12);
+        assert_eq!(price_rounds(1800), 16);
+        assert_eq!(price_rounds(300), 16);
+        assert_eq!(price_rounds(0), 16);
     }
 
     /// Shares of a plan, counted by hand: segment 0 until tick 10, segment 1 (continued at 20)
