@@ -225,18 +225,9 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
         scott.join("2_scott_0_1_1.wav"),
         scott.join("2_scott_0_2_2.wav"),
     );
-    let library = [ze.clone()];
-    let eval = |extra: &[&std::ffi::OsStr]| eval_motion(&model, &library, extra);
 
     // Against the capture of the same speech.
-    let own = eval(&[
-        "--audio".as_ref(),
-        wav.as_os_str(),
-        "--mocap".as_ref(),
-        bvh.as_os_str(),
-        "--span".as_ref(),
-        "40:50".as_ref(),
-    ]);
+    let own = eval_with_capture(&model, &ze, (&wav, &bvh), &["--span", "40:50"]);
     let (online, mocap) = (row(&own, "online"), row(&own, "mocap"));
     eprintln!("zeroeggs 40-50 s: online {online:?}\nmocap {mocap:?}");
     assert!(
@@ -267,7 +258,11 @@ fn online_controller_varies_flows_and_cuts_smoothly_on_held_out_speech() {
     );
 
     // Two minutes of another speaker.
-    let other = eval(&["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()]);
+    let other = eval_motion(
+        &model,
+        std::slice::from_ref(&ze),
+        &["--audio".as_ref(), s1.as_os_str(), s2.as_os_str()],
+    );
     let (online, random) = (row(&other, "online"), row(&other, "random"));
     eprintln!("beat-scott: online {online:?}\nrandom {random:?}");
     assert!(online.seconds > 120.0, "{}", online.seconds);

@@ -26,16 +26,16 @@ pub const DISTINCT_MIN: f32 = 0.5;
 const PRICE_STEP: f32 = 1.0;
 /// How much an unplayed segment's prize rises per unit of the distinct shortfall (relative).
 const PRIZE_STEP: f32 = 2.0;
-/// Plans made while raising prices, for a run of two minutes or more.
+/// Plans made while raising prices, for a run of [`BUDGET_TICKS`] ticks or more.
 pub const PRICE_ROUNDS: usize = 8;
 /// Most plans made for a shorter run.
 pub const MAX_PRICE_ROUNDS: usize = 16;
-/// The ticks of two minutes at 30 frames per second: the run whose [`PRICE_ROUNDS`] plans set
-/// the planning work allowed.
-const BUDGET_TICKS: u64 = 3600;
+/// The ticks (two minutes at 30 frames per second, one at 60) of the run whose
+/// [`PRICE_ROUNDS`] plans set the planning work allowed.
+pub const BUDGET_TICKS: u64 = 3600;
 
 /// How many plans the ascent may make for a run of `ticks` ticks: as many as the work of
-/// [`PRICE_ROUNDS`] plans of two minutes allows (a plan's work grows with its ticks), from
+/// [`PRICE_ROUNDS`] plans of [`BUDGET_TICKS`] ticks allows (a plan's work grows with its ticks), from
 /// [`PRICE_ROUNDS`] to [`MAX_PRICE_ROUNDS`]. A short run's ascent, which meets the lines
 /// less easily (one long pause is a large share of ten seconds), gets more plans for the same
 /// time.
@@ -184,7 +184,8 @@ mod tests {
         planned(tick, Act::Enter { segment, rate: 1.0 })
     }
 
-    /// Two minutes or more at 30 fps: 8 plans; one minute: 16; ten seconds: 16 (the most).
+    /// 3600 ticks or more (two minutes at 30 fps): 8 plans; 2400: 12; one minute at 30 fps
+    /// and less: 16 (the most).
     #[test]
     fn a_short_run_gets_more_plans_for_the_same_work() {
         assert_eq!(price_rounds(3600), 8);
