@@ -617,4 +617,26 @@ mod tests {
         assert_eq!((r.extras(), r.energy()), (&[3u16, 1, 4][..], 0.5));
         assert_eq!(RestSet::of(&t, 0).segments(), &[] as &[u16]);
     }
+
+    #[test]
+    fn a_long_rest_hands_over_to_the_least_used_other_rest() {
+        let t = Energies(&[0.5, -1.0, 2.0, -2.0, -1.0, 0.0, 1.0, -0.5]);
+        let r = RestSet::of(&t, 8);
+        // The rests 3, 1, 4, 7 have played these shares of the recent frames.
+        let used = |c: usize| match c {
+            3 => 0.2,
+            1 => 0.1,
+            4 => 0.05,
+            7 => 0.3,
+            _ => 1.0,
+        };
+        assert_eq!(r.hand_over(3, used), Some(4));
+        assert_eq!(r.hand_over(4, used), Some(1));
+        // A tie goes to the calmer (3 before 1 before 4).
+        assert_eq!(r.hand_over(7, |_| 0.0), Some(3));
+        assert_eq!(r.hand_over(3, |_| 0.0), Some(1));
+        // With one rest there is no other.
+        assert_eq!(RestSet::of(&t, 2).hand_over(1, used), None);
+        assert_eq!(RestSet::EMPTY.hand_over(0, used), None);
+    }
 }

@@ -7,6 +7,11 @@ use crate::policy::{PolicyTables, REST_EXTRAS};
 /// The calmest segments, candidates at every exit point while resting.
 pub const REST_SET: usize = 6;
 
+/// The most of the variety costs' usage window (`usage_ms`) one rest may fill while it holds
+/// a pause before it hands over to another ([`RestSet::hand_over`]): the variety line (no
+/// segment over 15 % of a run) less a margin for the blend; 6.3 s of the default 45 s.
+pub const HOLD_SHARE: f32 = 0.14;
+
 /// The calmest segments of `t` (lowest energy, ties to the lower index), in order of energy:
 /// [`REST_SET`], or the calmer half of a smaller library (at least one), so a rest is never
 /// any segment at all.
@@ -64,6 +69,28 @@ impl RestSet {
     /// (-inf when there are none).
     pub fn energy(&self) -> f32 {
         self.energy
+    }
+
+    /// The rest to hand over to from `current`: of the others, the one with the least `used`
+    /// (its share of the recent frames), the calmer on a tie. `None` when there is no other.
+    ///
+    /// A rest held through long pauses shifts, now and then, to another of the calmest
+    /// postures, as a speaker at rest does, rather than playing one segment to and fro for
+    /// as long as the silences last (one segment held through a 9 s pause was 15 % of a
+    /// minute).
+    pub fn hand_over(&self, current: usize, used: impl Fn(usize) -> f32) -> Option<usize> {
+        let mut best: Option<(usize, f32)> = None;
+        for &c in self.segments() {
+            let c = c as usize;
+            if c == current {
+                continue;
+            }
+            let u = used(c);
+            if best.is_none_or(|(_, b)| u < b) {
+                best = Some((c, u));
+            }
+        }
+        best.map(|(c, _)| c)
     }
 
     /// Whether `c` is one of them.

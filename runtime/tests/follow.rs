@@ -127,6 +127,10 @@ struct Tick {
 }
 
 fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
+    run_with(samples, follow, Variety::NONE)
+}
+
+fn run_with(samples: &[i16], follow: VoiceFollow, variety: Variety) -> Vec<Tick> {
     let t = Tables::new();
     let mut bytes = Vec::new();
     for v in [0i16, 0, 0, 0] {
@@ -143,7 +147,7 @@ fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
     .unwrap();
     let g = [GmmComponent::default(), GmmComponent::default()];
     let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &Lib).unwrap();
-    c.set_variety(Variety::NONE);
+    c.set_variety(variety);
     c.set_follow(follow);
     let mut ticks: Vec<Tick> = Vec::new();
     let mut heard = false;
@@ -233,6 +237,53 @@ fn a_pause_brings_the_calmest_segments_held_to_and_fro_until_the_speech_returns(
         "{:?}",
         &ticks[back..back + 3]
     );
+}
+
+#[test]
+fn a_rest_held_through_a_long_pause_hands_over_to_the_other_rest() {
+    // Speech 0-3 s, silence 3-15 s. A usage window of 20 s: a rest hands over once it has
+    // filled 0.14 of it (2.8 s), at its next turn.
+    let samples = audio(15.0, |t| t < 3.0);
+    let variety = Variety {
+        recency_cost: 0.0,
+        recency_ms: 0,
+        usage_cost: 1.0,
+        usage_ms: 20_000,
+    };
+    let ticks = run_with(&samples, FOLLOW, variety);
+    let first_rest = ticks.iter().position(|t| rest(t.segment)).unwrap();
+    let resting = &ticks[first_rest..];
+    // Only rests from then on, never frozen.
+    assert!(resting.iter().all(|t| rest(t.segment)));
+    for w in resting.windows(3) {
+        assert!(w[0].pose != w[1].pose || w[1].pose != w[2].pose);
+    }
+    // Each hold lasts at least 2.8 s, and at most that and one more traversal of the longest
+    // rest to a turn at the rest's slowest pace (30 frames at half speed: 2 s); a hold hands
+    // over to the other rest at one of its ends, with no decision.
+    let mut holds = vec![(first_rest, ticks[first_rest].segment)];
+    for (i, w) in ticks.windows(2).enumerate().skip(first_rest) {
+        if w[1].segment != w[0].segment {
+            assert_ne!(holds.last().unwrap().1, w[1].segment);
+            // The frame shown last is next to an end (the player has reached it).
+            let len = LENS[w[0].segment];
+            assert!(w[0].frame <= 1 || w[0].frame + 2 >= len, "{w:?}");
+            assert_eq!(w[1].frame, 0);
+            assert!(!w[1].decided);
+            holds.push((i + 1, w[1].segment));
+        }
+    }
+    assert!(holds.len() >= 3, "{holds:?}");
+    for h in holds.windows(2) {
+        let held = (h[1].0 - h[0].0) as f32 / 30.0;
+        assert!((2.8..=4.9).contains(&held), "held {held} s: {holds:?}");
+    }
+    // Without variety costs one rest holds the whole silence.
+    let ticks = run(&samples, FOLLOW);
+    let first_rest = ticks.iter().position(|t| rest(t.segment)).unwrap();
+    assert!(ticks[first_rest..]
+        .iter()
+        .all(|t| t.segment == ticks[first_rest].segment));
 }
 
 #[test]

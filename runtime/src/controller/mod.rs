@@ -462,8 +462,16 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             return;
         }
         if self.voice.resting() && self.rest.contains(segment) && self.deferred.is_none() {
-            // A rest holds until the speech returns, played to and fro (see crate::follow).
-            if !self.player.backward() && self.player.at_end(self.lib) {
+            // A rest holds until the speech returns, played to and fro (see crate::follow);
+            // held for long, it hands over to another at its turn (crate::rest::HOLD_SHARE).
+            let at_end = !self.player.backward() && self.player.at_end(self.lib);
+            if at_end || self.player.position() <= 0.0 {
+                if let Some(c) = self.rest_hand_over(segment, tick) {
+                    self.cut(c, 0, tick, sink);
+                    return;
+                }
+            }
+            if at_end {
                 self.player.turn();
                 self.play(PlayerCommand::Turn, sink);
             }
@@ -613,6 +621,27 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         // An interruption exit point early in the cut's blend is passed by (`FRESH_BLEND`).
         let fresh = (self.player.blend_ticks() / FRESH_BLEND) as usize;
         self.record_entry(c, tick.min(u32::MAX as u64) as u32, fresh);
+    }
+
+    /// The rest to hand `segment` over to at `tick`, once it has held for
+    /// [`HOLD_SHARE`](crate::rest::HOLD_SHARE) of the usage window: the one least played in
+    /// that window (none without variety costs).
+    fn rest_hand_over(&self, segment: usize, tick: u64) -> Option<usize> {
+        let v = &self.variety;
+        let window = self.ms_ticks(v.usage_ms);
+        if v.usage_cost <= 0.0 || window == 0 {
+            return None;
+        }
+        let now = tick.min(u32::MAX as u64) as u32;
+        let since = self
+            .history
+            .recent()
+            .filter(|h| h.segment as usize == segment)?;
+        if (now.saturating_sub(since.tick) as f32) < crate::rest::HOLD_SHARE * window as f32 {
+            return None;
+        }
+        let p = Penalties::new(v, &self.history, now, 0, window);
+        self.rest.hand_over(segment, |c| p.usage_of(c))
     }
 
     /// Remembers entering `c` at tick `now` and finds its first exit point not yet passed,
