@@ -242,7 +242,7 @@ fn a_pause_brings_the_calmest_segments_held_to_and_fro_until_the_speech_returns(
 #[test]
 fn a_rest_held_through_a_long_pause_hands_over_to_the_other_rest() {
     // Speech 0-3 s, silence 3-15 s. A usage window of 20 s: a rest hands over once it has
-    // filled 0.14 of it (2.8 s), at its next turn.
+    // held for 0.14 of it (2.8 s), at its next turn.
     let samples = audio(15.0, |t| t < 3.0);
     let variety = Variety {
         recency_cost: 0.0,
@@ -260,7 +260,8 @@ fn a_rest_held_through_a_long_pause_hands_over_to_the_other_rest() {
     }
     // Each hold lasts at least 2.8 s, and at most that and one more traversal of the longest
     // rest to a turn at the rest's slowest pace (30 frames at half speed: 2 s); a hold hands
-    // over to the other rest at one of its ends, with no decision.
+    // over to the other rest at one of its ends, into the other's first frame, with no
+    // decision.
     let mut holds = vec![(first_rest, ticks[first_rest].segment)];
     for (i, w) in ticks.windows(2).enumerate().skip(first_rest) {
         if w[1].segment != w[0].segment {

@@ -170,6 +170,8 @@ pub struct Controller<
     voice: Voice,
     /// The calmest segments (candidates while resting).
     rest: RestSet,
+    /// The tick the last rest began.
+    rest_since: u32,
     /// Length of a pause step (ms).
     pause_ms: u32,
     /// The segment and frame shown at the last tick.
@@ -222,6 +224,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             expression: Expressive::NONE,
             voice: Voice::new(),
             rest: RestSet::EMPTY,
+            rest_since: 0,
             pause_ms: config.syllables.pause_frames.saturating_mul(10),
             ahead: Ahead::new(),
             last_shown: (0, 0),
@@ -463,15 +466,15 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         }
         if self.voice.resting() && self.rest.contains(segment) && self.deferred.is_none() {
             // A rest holds until the speech returns, played to and fro (see crate::follow);
-            // held for long, it hands over to another at its turn (crate::rest::HOLD_SHARE).
+            // held for long, it hands over to another at a turn (crate::rest::HOLD_SHARE).
             let at_end = !self.player.backward() && self.player.at_end(self.lib);
-            if at_end || self.player.position() <= 0.0 {
-                if let Some(c) = self.rest_hand_over(segment, tick) {
-                    self.cut(c, 0, tick, sink);
-                    return;
-                }
-            }
-            if at_end {
+            let turning = at_end || self.player.position() <= 0.0;
+            if let Some(c) = turning
+                .then(|| self.rest_hand_over(segment, tick))
+                .flatten()
+            {
+                self.cut(c, 0, tick, sink);
+            } else if at_end {
                 self.player.turn();
                 self.play(PlayerCommand::Turn, sink);
             }
@@ -623,7 +626,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         self.record_entry(c, tick.min(u32::MAX as u64) as u32, fresh);
     }
 
-    /// The rest to hand `segment` over to at `tick`, once it has held for
+    /// The rest to hand `segment` over to at `tick`, once it has held a rest for
     /// [`HOLD_SHARE`](crate::rest::HOLD_SHARE) of the usage window: the one least played in
     /// that window (none without variety costs).
     fn rest_hand_over(&self, segment: usize, tick: u64) -> Option<usize> {
@@ -633,11 +636,13 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             return None;
         }
         let now = tick.min(u32::MAX as u64) as u32;
-        let since = self
+        // Held since it was entered or since the rest began, whichever is later.
+        let entered = self
             .history
             .recent()
             .filter(|h| h.segment as usize == segment)?;
-        if (now.saturating_sub(since.tick) as f32) < crate::rest::HOLD_SHARE * window as f32 {
+        let since = entered.tick.max(self.rest_since);
+        if (now.saturating_sub(since) as f32) < crate::rest::HOLD_SHARE * window as f32 {
             return None;
         }
         let p = Penalties::new(v, &self.history, now, 0, window);
@@ -675,6 +680,9 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         let Some(change) = self.voice.take_change() else {
             return false;
         };
+        if change == VoiceChange::Rest {
+            self.rest_since = tick.min(u32::MAX as u64) as u32;
+        }
         if self.labels.waiting().is_some()
             || (change == VoiceChange::Rest && self.rest.contains(segment))
         {
