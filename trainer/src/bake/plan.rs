@@ -20,6 +20,10 @@
 //! - **strokes on syllables**: each library stroke (`library.peaks`) the choice plays earns
 //!   `STROKE_GAIN` times a Gaussian (sigma `STROKE_SIGMA_S`, the width of `eval-motion`'s beat
 //!   kernel) of its distance to the nearest syllable onset;
+//! - **the blend's peak**: a cut into a gesture brings the hands' speed to a peak about
+//!   `BLEND_PEAK_S` later (the blend closing the posture, the new segment's first motion),
+//!   which the eye reads as a stroke as much as the library's own; it earns `BLEND_GAIN` of a
+//!   stroke's gain at its distance to the nearest onset;
 //! - **pace**: each choice plays at one of `RATES`, costing `PACE_COST * |ln rate|`, so a stroke
 //!   is moved only when it lands better;
 //! - **cuts**: a cut waits for the hands' next pause, as live (`defer_cut_ms`), and costs
@@ -51,6 +55,9 @@ pub struct Weights {
     /// Cost of a cut per unit of the pose's motion on its two sides (over the library's
     /// median motion per frame).
     pub cut_cost: f32,
+    /// What the hands' speed peak after a cut into a gesture earns on a syllable onset, as a
+    /// share of what a stroke earns.
+    pub blend_gain: f32,
 }
 
 impl Default for Weights {
@@ -59,6 +66,7 @@ impl Default for Weights {
             stroke_gain: STROKE_GAIN,
             pace_cost: PACE_COST,
             cut_cost: CUT_COST,
+            blend_gain: BLEND_GAIN,
         }
     }
 }
@@ -89,6 +97,12 @@ pub const PACE_COST: f32 = 1.0;
 pub const STROKE_GAIN: f32 = 1.5;
 /// Width of the stroke-to-onset kernel (s).
 pub const STROKE_SIGMA_S: f64 = 0.1;
+/// What the speed peak after a cut earns, as a share of a stroke's gain (see
+/// [`Weights::blend_gain`]).
+pub const BLEND_GAIN: f32 = 0.5;
+/// How long after a cut the hands' speed peaks (s): the blend closing the posture and the new
+/// segment's first motion (docs/method.md, "Onsets at their syllable").
+pub const BLEND_PEAK_S: f64 = 0.17;
 
 /// An action of the plan.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -199,6 +213,8 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
         all.get(all.len() / 2).copied().unwrap_or(1.0).max(1e-6)
     };
     let cut_cost = w.cut_cost / median_motion;
+    // A cut's blend peak: `onset_gain` is a stroke's, so this is its share.
+    let (blend_gain, blend_lag) = (w.blend_gain, BLEND_PEAK_S * fps);
     // Where a cut from frame `f` of segment `c` falls: the frame itself if the hands pause
     // there, else the first calm frame, else the first motion beat, else the last frame, within
     // the live controller's deferral window (`None`: none does; the cut cannot be made here).
@@ -427,6 +443,9 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                     if !(run_on && c == playing + 1) {
                         let in_motion = motion[c].first().copied().unwrap_or(0.0);
                         base += cut_cost * (out_motion + in_motion);
+                        if matches!(act, Act::Enter { .. }) {
+                            base -= blend_gain * onset_gain(tc as f64 + blend_lag);
+                        }
                     }
                 }
                 match act {

@@ -145,6 +145,50 @@ fn the_stroke_term_lands_strokes_on_onsets() {
     assert!(a > b + 0.05, "with the stroke term {a:.3}, without {b:.3}");
 }
 
+/// The blend term is what puts the hands' speed peak after a cut on a syllable: baked
+/// without it, the ticks `BLEND_PEAK_S` after its cuts into gestures lie further from onsets.
+#[test]
+fn the_blend_term_puts_the_peak_after_a_cut_on_an_onset() {
+    let (bytes, speech) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let (_, tl) = timeline(&blob, &speech);
+    let fps = blob.fps() as f64;
+    let (lag, sigma) = (plan::BLEND_PEAK_S * fps, plan::STROKE_SIGMA_S * fps);
+    let after_cuts = |w: &Weights| -> f64 {
+        let b = bake_with(&blob, &speech, w).unwrap();
+        let rests = RestSet::of(&blob, blob.segment_count());
+        let peaks: Vec<f64> = b
+            .commands
+            .iter()
+            .filter_map(|&(k, c)| match c {
+                PlayerCommand::Enter { segment, .. } if !rests.contains(segment as usize) => {
+                    Some(k as f64 + lag)
+                }
+                _ => None,
+            })
+            .collect();
+        assert!(peaks.len() >= 5, "{} cuts", peaks.len());
+        let kernel = |t: f64| {
+            let d = tl
+                .onsets
+                .iter()
+                .map(|&o| (o - t).abs())
+                .fold(f64::INFINITY, f64::min);
+            (-0.5 * (d / sigma).powi(2)).exp()
+        };
+        peaks.iter().map(|&t| kernel(t)).sum::<f64>() / peaks.len() as f64
+    };
+    let with = after_cuts(&Weights::default());
+    let without = after_cuts(&Weights {
+        blend_gain: 0.0,
+        ..Weights::default()
+    });
+    assert!(
+        with > without + 0.05,
+        "blend peaks on onsets: with the term {with:.3}, without {without:.3}"
+    );
+}
+
 /// The cut term is what puts cuts where the body is still: baked without it, the pose moves
 /// more at the ticks its cuts show.
 #[test]

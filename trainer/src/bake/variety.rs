@@ -29,7 +29,7 @@ const PRIZE_STEP: f32 = 2.0;
 /// Plans made while raising prices, for a run of [`BUDGET_TICKS`] ticks or more.
 pub const PRICE_ROUNDS: usize = 8;
 /// Most plans made for a shorter run.
-pub const MAX_PRICE_ROUNDS: usize = 16;
+pub const MAX_PRICE_ROUNDS: usize = 32;
 /// The ticks (two minutes at 30 frames per second, one at 60) of the run whose
 /// [`PRICE_ROUNDS`] plans set the planning work allowed.
 pub const BUDGET_TICKS: u64 = 3600;
@@ -184,16 +184,17 @@ mod tests {
         planned(tick, Act::Enter { segment, rate: 1.0 })
     }
 
-    /// 3600 ticks or more (two minutes at 30 fps): 8 plans; 2400: 12; one minute at 30 fps
-    /// and less: 16 (the most).
+    /// 3600 ticks or more (two minutes at 30 fps): 8 plans; 2400: 12; one minute at 30 fps:
+    /// 16; 30 s and less: 32 (the most).
     #[test]
     fn a_short_run_gets_more_plans_for_the_same_work() {
         assert_eq!(price_rounds(3600), 8);
         assert_eq!(price_rounds(7200), 8);
         assert_eq!(price_rounds(2400), 12);
         assert_eq!(price_rounds(1800), 16);
-        assert_eq!(price_rounds(300), 16);
-        assert_eq!(price_rounds(0), 16);
+        assert_eq!(price_rounds(900), 32);
+        assert_eq!(price_rounds(300), 32);
+        assert_eq!(price_rounds(0), 32);
     }
 
     /// Shares of a plan, counted by hand: segment 0 until tick 10, segment 1 (continued at 20)
