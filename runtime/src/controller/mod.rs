@@ -65,6 +65,7 @@ mod ahead;
 mod build;
 mod event;
 mod labels;
+mod resting;
 mod settings;
 
 use crate::blob::Blob;
@@ -465,19 +466,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             return;
         }
         if self.voice.resting() && self.rest.contains(segment) && self.deferred.is_none() {
-            // A rest holds until the speech returns, played to and fro (see crate::follow);
-            // held for long, it hands over to another at a turn (crate::rest::HOLD_SHARE).
-            let at_end = !self.player.backward() && self.player.at_end(self.lib);
-            let turning = at_end || self.player.position() <= 0.0;
-            if let Some(c) = turning
-                .then(|| self.rest_hand_over(segment, tick))
-                .flatten()
-            {
-                self.cut(c, 0, tick, sink);
-            } else if at_end {
-                self.player.turn();
-                self.play(PlayerCommand::Turn, sink);
-            }
+            self.hold_rest(segment, tick, sink);
             return;
         }
         let t = self.timing;
@@ -624,29 +613,6 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         // An interruption exit point early in the cut's blend is passed by (`FRESH_BLEND`).
         let fresh = (self.player.blend_ticks() / FRESH_BLEND) as usize;
         self.record_entry(c, tick.min(u32::MAX as u64) as u32, fresh);
-    }
-
-    /// The rest to hand `segment` over to at `tick`, once it has held a rest for
-    /// [`HOLD_SHARE`](crate::rest::HOLD_SHARE) of the usage window: the one least played in
-    /// that window (none without variety costs).
-    fn rest_hand_over(&self, segment: usize, tick: u64) -> Option<usize> {
-        let v = &self.variety;
-        let window = self.ms_ticks(v.usage_ms);
-        if v.usage_cost <= 0.0 || window == 0 {
-            return None;
-        }
-        let now = tick.min(u32::MAX as u64) as u32;
-        // Held since it was entered or since the rest began, whichever is later.
-        let entered = self
-            .history
-            .recent()
-            .filter(|h| h.segment as usize == segment)?;
-        let since = entered.tick.max(self.rest_since);
-        if (now.saturating_sub(since) as f32) < crate::rest::HOLD_SHARE * window as f32 {
-            return None;
-        }
-        let p = Penalties::new(v, &self.history, now, 0, window);
-        self.rest.hand_over(segment, |c| p.usage_of(c))
     }
 
     /// Remembers entering `c` at tick `now` and finds its first exit point not yet passed,
