@@ -56,6 +56,15 @@ fn pose_step(poses: &[BakedPose], k: usize) -> f64 {
         .sum()
 }
 
+/// The beat kernel (width `sigma`, ticks) of tick `t`'s distance to the nearest onset.
+fn onset_kernel(onsets: &[f64], t: f64, sigma: f64) -> f64 {
+    let d = onsets
+        .iter()
+        .map(|&o| (o - t).abs())
+        .fold(f64::INFINITY, f64::min);
+    (-0.5 * (d / sigma).powi(2)).exp()
+}
+
 /// Mean over the library strokes shown of the beat kernel (sigma 0.1 s) to the nearest onset.
 fn stroke_alignment(blob: &Blob<'_>, poses: &[BakedPose], onsets: &[f64], fps_milli: u64) -> f64 {
     let sigma = 0.1 * fps_milli as f64 / 1000.0;
@@ -63,11 +72,7 @@ fn stroke_alignment(blob: &Blob<'_>, poses: &[BakedPose], onsets: &[f64], fps_mi
     for (k, p) in poses.iter().enumerate() {
         let prev = k.checked_sub(1).map(|j| (poses[j].segment, poses[j].frame));
         if blob.is_peak(p.segment, p.frame) && prev != Some((p.segment, p.frame)) {
-            let d = onsets
-                .iter()
-                .map(|&o| (o - k as f64).abs())
-                .fold(f64::INFINITY, f64::min);
-            v.push((-0.5 * (d / sigma).powi(2)).exp());
+            v.push(onset_kernel(onsets, k as f64, sigma));
         }
     }
     assert!(v.len() >= 5, "too few strokes shown: {}", v.len());
@@ -168,15 +173,11 @@ fn the_blend_term_puts_the_peak_after_a_cut_on_an_onset() {
             })
             .collect();
         assert!(peaks.len() >= 5, "{} cuts", peaks.len());
-        let kernel = |t: f64| {
-            let d = tl
-                .onsets
-                .iter()
-                .map(|&o| (o - t).abs())
-                .fold(f64::INFINITY, f64::min);
-            (-0.5 * (d / sigma).powi(2)).exp()
-        };
-        peaks.iter().map(|&t| kernel(t)).sum::<f64>() / peaks.len() as f64
+        peaks
+            .iter()
+            .map(|&t| onset_kernel(&tl.onsets, t, sigma))
+            .sum::<f64>()
+            / peaks.len() as f64
     };
     let with = after_cuts(&Weights::default());
     let without = after_cuts(&Weights {
