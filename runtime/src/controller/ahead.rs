@@ -56,10 +56,6 @@ pub const WARP_MAX: f32 = 1.5;
 /// of a second.
 pub const RATE_SLEW_PER_S: f32 = 2.0;
 
-/// How long the pace holds after a stroke (ms): about the smoothing over which a viewer (and
-/// `eval-motion`) sees the hands' speed peak.
-pub const STEADY_MS: u32 = 150;
-
 /// How the controller uses audio it hears before it is played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Lookahead {
@@ -146,9 +142,6 @@ pub(super) struct Ahead {
     /// The rate given last (slewed towards the next), and the largest change per tick.
     rate: f32,
     slew: f32,
-    /// Ticks the pace holds after a stroke, and until when it holds.
-    steady: u64,
-    steady_until: u64,
     /// Ticks before its syllable an onset counts for decisions.
     decision_lead: u64,
 }
@@ -178,8 +171,6 @@ impl Ahead {
             aim: None,
             rate: 1.0,
             slew: 0.0,
-            steady: 0,
-            steady_until: 0,
             decision_lead: 0,
         }
     }
@@ -212,8 +203,6 @@ impl Ahead {
         self.reach = ms_ticks(l.ms.saturating_add(l.stroke_shift_ms), fps_milli) as usize;
         self.aim = None;
         self.rate = 1.0;
-        self.steady = ms_ticks(STEADY_MS, fps_milli);
-        self.steady_until = 0;
         self.slew = RATE_SLEW_PER_S * 1000.0 / fps_milli.max(1) as f32;
     }
 
@@ -302,9 +291,6 @@ impl Ahead {
             self.rate = 1.0;
             return 1.0;
         }
-        if now < self.steady_until {
-            return self.rate;
-        }
         let want = self.wanted_rate(lib, player, now);
         // (max and min, not clamp: clamp with bounds not known at build time links float
         // formatting for its panic message, kilobytes on a board.)
@@ -332,9 +318,9 @@ impl Ahead {
             },
         };
         if aim.at.is_some_and(|at| at <= now) {
-            // The stroke is shown: its pace holds a little longer, so the hands' speed peaks
-            // where the stroke is (a pace that changes at the stroke moves the peak).
-            self.steady_until = now + self.steady;
+            // Its tick has come before the stroke (the slew or the player's bounds held the
+            // pace back): the aim ends. No pace is held past a stroke either: the next
+            // stroke's approach begins at once (docs/method.md).
             self.aim = None;
             return self.rate;
         }
@@ -418,6 +404,29 @@ mod tests {
         }
     }
 
+    /// One segment of 100 frames at 30 fps with strokes at frames 40 and 48 (0.27 s apart).
+    struct TwoStrokes;
+    impl LibraryFrames for TwoStrokes {
+        fn channels(&self) -> usize {
+            1
+        }
+        fn fps(&self) -> f32 {
+            30.0
+        }
+        fn segment_count(&self) -> usize {
+            1
+        }
+        fn segment_len(&self, _: usize) -> usize {
+            100
+        }
+        fn value(&self, _: usize, f: usize, _: usize) -> f32 {
+            f as f32
+        }
+        fn is_peak(&self, _: usize, f: usize) -> bool {
+            f == 40 || f == 48
+        }
+    }
+
     /// Plays `Stroke` from tick 0 with `ahead` steering the rate; the tick at which the
     /// stroke frame is first reached.
     fn stroke_tick(ahead: &mut Ahead) -> u64 {
@@ -467,5 +476,35 @@ mod tests {
         far.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
         far.onset(170, 0, FPS_MILLI); // tick 51: 367 ms late
         assert_eq!(stroke_tick(&mut far), 40);
+    }
+
+    #[test]
+    fn the_next_stroke_is_aimed_as_soon_as_one_is_shown() {
+        const FPS_MILLI: u64 = 30_000;
+        let mut ahead = Ahead::new();
+        ahead.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
+        // Onsets at ticks 40 (the first stroke's own time) and 51 (three ticks after the
+        // second stroke's): the second is reached only by slowing at once to about 0.7x.
+        ahead.onset(133, 0, FPS_MILLI);
+        ahead.onset(170, 0, FPS_MILLI);
+        let mut player = Player::new();
+        let mut out = [0.0; crate::player::MAX_CHANNELS];
+        let (mut first, mut second) = (None, None);
+        for now in 0..100u64 {
+            let r = ahead.stroke_rate(&TwoStrokes, &player, now);
+            player.set_rate(r);
+            player.tick(&TwoStrokes, &mut out);
+            if first.is_none() && out[0] >= 40.0 - 1e-3 {
+                first = Some(now);
+            }
+            if second.is_none() && out[0] >= 48.0 - 1e-3 {
+                second = Some(now);
+            }
+        }
+        assert_eq!(first, Some(40));
+        // Holding the pace past the first stroke for 150 ms left the second out of reach
+        // (tick 48).
+        let second = second.unwrap_or(u64::MAX);
+        assert!(second.abs_diff(51) <= 1, "{second}");
     }
 }
