@@ -287,6 +287,14 @@ impl Voice {
         }
     }
 
+    /// Before anyone has spoken: resting if `f` rests at all (so the first syllable is the
+    /// speech's return, which decides at once, as after any pause), with no change to report.
+    pub const fn silent(f: &VoiceFollow) -> Self {
+        let mut v = Self::new();
+        v.resting = f.rest_ms > 0 && f.rest_cost > 0.0;
+        v
+    }
+
     /// A step: a pause step of `pause_ms` (silence goes on) or a syllable at `level`.
     pub fn step(&mut self, f: &VoiceFollow, pause: bool, level: f32, pause_ms: u32) {
         if !pause {
@@ -511,6 +519,21 @@ mod tests {
         // Speaking again, the voice's gain, whatever plays.
         let g = 1.0 + e.span * (-0.25 / VOICE_SPAN);
         assert!((v.gain(&e, false) - g).abs() < 1e-6 && v.gain(&e, true) == v.gain(&e, false));
+    }
+
+    #[test]
+    fn before_anyone_speaks_the_voice_rests_and_the_first_onset_is_its_return() {
+        let mut v = Voice::silent(&F);
+        assert!(v.resting());
+        assert_eq!(v.take_change(), None);
+        v.onset();
+        assert!(!v.resting());
+        assert_eq!(v.take_change(), Some(VoiceChange::Speak));
+        // Without rests (the paper's rule) it does not.
+        let mut n = Voice::silent(&VoiceFollow::NONE);
+        assert!(!n.resting());
+        n.onset();
+        assert_eq!(n.take_change(), None);
     }
 
     #[test]

@@ -311,11 +311,18 @@ fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
         .enumerate()
         .filter_map(|(i, t)| t.gain.map(|g| (i, g)))
         .collect();
+    // Before the first syllable nobody has spoken: whatever plays is shown at the size of a
+    // gesture the rest caught. The first syllable is heard within a quarter second.
+    let first = aims
+        .iter()
+        .position(|&(_, g)| g != EXPRESSION.caught)
+        .unwrap();
+    assert!(aims[first].0 <= at(0.25), "{aims:?}");
     // While speaking, within the voice's span (a first syllable's level moves it), down to
     // the pause's size in the quiet between syllables (`follow::QUIET_SPAN`).
     let (lo, hi) = (EXPRESSION.pause, 1.0 + EXPRESSION.span);
-    assert!(aims.iter().any(|&(i, _)| i < at(3.0)), "{aims:?}");
-    for &(i, g) in aims.iter().filter(|&&(i, _)| i < at(3.0)) {
+    assert!(aims[first..].iter().any(|&(i, _)| i < at(3.0)), "{aims:?}");
+    for &(i, g) in aims[first..].iter().filter(|&&(i, _)| i < at(3.0)) {
         assert!((lo..=hi).contains(&g), "gain {g} at tick {i}");
     }
     // The first pause step of the silence (a quarter second, reported at its end) halves the
@@ -406,4 +413,20 @@ fn louder_syllables_choose_more_energetic_segments() {
     // 12 dB quieter: mostly the calmer gesture; 6 dB louder: no more of it than steady.
     assert!(quiet > 0.6 && quiet > steady + 0.3, "{quiet} vs {steady}");
     assert!(loud <= steady, "{loud} vs {steady}");
+}
+
+#[test]
+fn speech_from_the_first_sample_decides_at_its_first_syllable() {
+    // Speech from the start: before the first syllable nobody has spoken, so the first
+    // syllable is the speech's return and decides at once, not at segment 0's first exit
+    // point (frame 22, 0.73 s).
+    let samples = audio(3.0, |_| true);
+    let ticks = run(&samples, FOLLOW);
+    let onset = ticks.iter().position(|t| t.onset).unwrap();
+    let decided = ticks.iter().position(|t| t.decided).unwrap();
+    assert!(onset < 12, "first onset at tick {onset}");
+    assert!(decided <= onset + 1, "onset {onset}, decided {decided}");
+    // Without the voice followed (the paper's rule) the first decision waits for the exit.
+    let ticks = run(&samples, VoiceFollow::NONE);
+    assert!(ticks.iter().position(|t| t.decided).unwrap() >= 21);
 }

@@ -2,7 +2,7 @@
 //! voice, varies, styles, serves labels, times its decisions and looks ahead.
 
 use super::{Controller, DecisionTiming, LabelError, Lookahead};
-use crate::follow::{rest_segments, Expressive, VoiceFollow};
+use crate::follow::{rest_segments, Expressive, Voice, VoiceFollow};
 use crate::inference::MAX_STATES;
 use crate::player::LibraryFrames;
 use crate::policy::{PolicyTables, Style, StyleError, Variety};
@@ -42,6 +42,10 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         self.follow = follow;
         self.expression = Expressive::of(&follow);
         self.rest = rest_segments(self.tables, self.lib.segment_count(), &follow);
+        if self.ticks == 0 {
+            // Nobody has spoken yet.
+            self.voice = Voice::silent(&follow);
+        }
         self.player.set_rest_segments(self.rest);
     }
 

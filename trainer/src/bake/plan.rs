@@ -38,7 +38,7 @@
 //! successor of any of its exit points.
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::follow::{rest_rate, RestSet};
+use gesture_runtime::follow::{rest_rate, RestSet, Voice};
 use gesture_runtime::player::LibraryFrames;
 use gesture_runtime::policy::{History, Penalties, PolicyTables, Variety, Visit, HISTORY};
 use gesture_runtime::rotation::wrap_deg;
@@ -217,13 +217,15 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
     let (blend_gain, blend_lag) = (w.blend_gain, BLEND_PEAK_S * fps);
     // Where a cut from frame `f` of segment `c` falls: the frame itself if the hands pause
     // there, else the first calm frame, else the first motion beat, else the last frame, within
-    // the live controller's deferral window (`None`: none does; the cut cannot be made here).
+    // the live controller's deferral window (`None`: none does; the cut cannot be made here;
+    // without a window, the frame itself).
     let defer = ms_ticks(blob.timing().defer_cut_ms) as usize;
     let len_of: Vec<usize> = (0..segments).map(|c| blob.segment_len(c)).collect();
     let pause_from = |c: usize, f: usize| -> Option<usize> {
         let len = len_of[c];
         let pause = |g: usize| blob.is_beat(c, g) || blob.is_calm(c, g) || g + 1 >= len;
-        if pause(f) {
+        // (Without a deferral window, live cuts at once.)
+        if pause(f) || defer == 0 {
             return Some(f);
         }
         let last = f.saturating_add(defer).min(len.saturating_sub(1));
@@ -296,17 +298,44 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
     ];
     // Segment entries: (segment, tick, parent).
     let mut arena: Vec<(u16, u32, u32)> = vec![(0, 0, NONE)];
-    // The player starts at segment 0's first frame: its first exit is reached at its frame.
+    // The player starts at segment 0's first frame: its first exit is reached at its frame
+    // (segment 0 charged its price for the ticks it plays, as every choice is).
     let e0 = blob.first_exit(0);
     let t0 = blob.exit_frame(e0).min(t_end);
+    let opening = |k: usize| {
+        let speaking = (0..k).filter(|&j| !tl.resting_at(j + 1)).count() as f32;
+        let rest_cost = if energy[0] <= rest.energy() {
+            follow.rest_cost * speaking
+        } else {
+            0.0
+        };
+        (w_mean(1, k + 1) * energy[0] * k as f32 + price(0) * k as f32 + rest_cost) / mean_interval
+    };
     cells[t0 * n + e0] = Cell {
-        cost: 0.0,
+        cost: opening(t0),
         prev: NONE,
         act: None,
         tick: 0,
         candidates: 0,
         chain: 0,
     };
+    // Segment 0 plays from the start. If the speech returns from a pause before its first
+    // exit point, the plan may also decide then (at that exit point, which the player is
+    // heading for: live, the speech's return decides at once), cutting from the frame shown;
+    // else a file that opens with a pause starts late.
+    let silent = Voice::silent(&follow).resting();
+    let early = (0..t0)
+        .find(|&k| !tl.resting_at(k) && k.checked_sub(1).map_or(silent, |j| tl.resting_at(j)));
+    if let Some(k) = early {
+        cells[k * n + e0] = Cell {
+            cost: opening(k),
+            prev: NONE,
+            act: None,
+            tick: 0,
+            candidates: 0,
+            chain: 0,
+        };
+    }
     // A state's entries once it is expanded (every way into it is known by then).
     let mut cand: Vec<(Act, f32, usize)> = Vec::new();
     for t in 0..t_end {
@@ -345,7 +374,10 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                 let r = extras[s - exits];
                 (last_exit[r], r)
             };
-            if s < exits && !blob.exit_is_end(e) {
+            // The early decision at segment 0's first exit point, before it is reached (above):
+            // the player shows frame `t`, and continuing is left to the way in at the exit.
+            let early_here = early == Some(t) && s == e0 && here.prev == NONE;
+            if s < exits && !blob.exit_is_end(e) && !early_here {
                 cand.push((
                     Act::Continue { rate: 1.0 },
                     blob.u_cont_dot(e, b) + pen.usage_of(playing),
@@ -413,7 +445,7 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
             }
             // A cut waits for the hands' next pause, as live: the tick it falls at.
             let (cut_at, cut_frame) = if s < exits {
-                let x = blob.exit_frame(e);
+                let x = if early_here { t } else { blob.exit_frame(e) };
                 let r_in = match here.act {
                     Some(Act::Continue { rate }) | Some(Act::Enter { rate, .. }) => rate,
                     _ => 1.0,

@@ -5,9 +5,15 @@ use crate::corpus::{load_corpus, LoadOptions};
 use crate::inference::train::{fit, sequences, FitConfig};
 use crate::pack::{pack_model, PackOptions};
 use crate::synth::{write_corpus, SynthParams};
+use gesture_runtime::policy::DecisionTiming;
 
 /// A blob packed from a synthetic corpus, and the speech of its first take.
 fn blob_and_speech() -> (Vec<u8>, Vec<i16>) {
+    blob_and_speech_with(&PackOptions::default())
+}
+
+/// [`blob_and_speech`] packed with `opts`.
+fn blob_and_speech_with(opts: &PackOptions) -> (Vec<u8>, Vec<i16>) {
     let dir = tempfile::tempdir().unwrap();
     let params = SynthParams {
         minutes: 1.0,
@@ -25,7 +31,7 @@ fn blob_and_speech() -> (Vec<u8>, Vec<i16>) {
         ..FitConfig::default()
     };
     let (model, _) = fit(&seqs, &segs, &cfg, &|_| {}).unwrap();
-    let packed = pack_model(&model, &[dir.path().to_path_buf()], &PackOptions::default()).unwrap();
+    let packed = pack_model(&model, &[dir.path().to_path_buf()], opts).unwrap();
     let mut wavs: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -306,4 +312,46 @@ fn the_bake_plays_half_the_library_where_the_speech_has_room() {
         baked.distinct()
     );
     assert!(baked.largest() <= SHARE_CAP, "baked: {}", baked.largest());
+}
+
+/// A file that opens with speech: the plan may leave segment 0 at the first syllable, not
+/// only at its first exit point (as live, where before anyone has spoken the first syllable
+/// is the speech's return and decides at once). Priced out (as the variety ascent prices a
+/// segment over its share), segment 0 is left there. (Cuts at once: the synthetic segment 0
+/// has no pause of the hands before its first exit point.)
+#[test]
+fn a_plan_can_leave_the_first_segment_at_the_first_syllable() {
+    let opts = PackOptions {
+        timing: DecisionTiming {
+            defer_cut_ms: 0,
+            ..DecisionTiming::DEFAULT
+        },
+        ..PackOptions::default()
+    };
+    let (bytes, speech) = blob_and_speech_with(&opts);
+    let blob = Blob::parse(&bytes).unwrap();
+    // The speech from 0.1 s before its first syllable.
+    let (_, whole) = timeline(&blob, &speech);
+    let rate = blob.prosody_config().sample_rate_hz as f64;
+    let fps = blob.fps() as f64;
+    let lead = ((whole.onsets[0] / fps - 0.1).max(0.0) * rate) as usize;
+    let (_, tl) = timeline(&blob, &speech[lead..]);
+    let first = tl.onsets[0];
+    let e0 = blob.exit_frame(blob.first_exit(0)) as f64;
+    assert!(
+        first + 8.0 < e0,
+        "first onset at tick {first}, segment 0's exit at {e0}"
+    );
+    let mut prices = vec![0.0f32; LibraryFrames::segment_count(&blob)];
+    prices[0] = 100.0;
+    let (planned, _) = plan::plan(&blob, &tl, &Weights::default(), &prices);
+    let cut = planned
+        .iter()
+        .find(|p| matches!(p.act, plan::Act::Enter { .. } | plan::Act::Rest { .. }))
+        .unwrap();
+    assert!(
+        cut.tick as f64 <= first,
+        "first cut at tick {}, onset {first}",
+        cut.tick
+    );
 }

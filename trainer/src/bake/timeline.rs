@@ -101,7 +101,7 @@ impl Timeline {
             .syllables
             .pause_frames
             .saturating_mul(10);
-        let mut voice = Voice::new();
+        let mut voice = Voice::silent(&follow);
         let expression = Expressive::of(&follow);
         let (mut resting, mut weight, mut gain, mut belief_at) = (
             Vec::with_capacity(ticks),
