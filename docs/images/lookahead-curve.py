@@ -48,7 +48,7 @@ def main():
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
     fig.suptitle(
-        "Known audio: 30-run means (all: one plan); dashed, the capture of the same speech",
+        "Known audio: 30-run means (all: 30 plans); dashed, the capture of the same speech",
         fontsize=10,
     )
     fig.tight_layout()

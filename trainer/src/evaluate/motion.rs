@@ -486,11 +486,14 @@ pub fn evaluate_motion(model: &InferenceModel, e: &MotionEval) -> Result<Evaluat
     for &h in &e.lookahead {
         progress.set_message(format!("eval-motion: {}", h.row_name()));
         if h == Horizon::All {
-            // The whole file planned: one run (the plan does not depend on the phase).
-            rows.push(Row::of_runs(
-                &h.row_name(),
-                &[measured(&play_baked(&blob, &samples, frames)?)?],
-            ));
+            // The whole file planned, once per run: the plan depends on where the speech
+            // meets the frames as much as a live run does.
+            let mut ms = Vec::with_capacity(runs);
+            for run in 0..runs {
+                let lead = Lead::of_run(run, step, rate);
+                ms.push(measured(&play_baked(&blob, &samples, rate, frames, lead)?)?);
+            }
+            rows.push(Row::of_runs(&h.row_name(), &ms));
             continue;
         }
         let mut ms = Vec::with_capacity(runs);

@@ -100,18 +100,28 @@ pub(crate) fn play_ahead(
     Ok(p)
 }
 
-/// The whole of `samples` planned and played from its show ([`crate::bake`]), `frames` ticks.
+/// The whole of `samples` after `lead` of silence planned and played from its show
+/// ([`crate::bake`]), measured from the end of the lead's whole frames (`frames` ticks), as
+/// [`play_delayed`] measures a live run: one plan is one draw of where the speech meets the
+/// front-end's frames and the animation's ticks.
 pub(crate) fn play_baked(
     blob: &Blob<'_>,
     samples: &[i16],
+    rate: u32,
     frames: usize,
+    lead: Lead,
 ) -> Result<Playback, EvalError> {
-    let baked = crate::bake::bake(blob, samples).map_err(|e| EvalError::Device(e.to_string()))?;
+    let delay = lead.frames;
+    let silence =
+        (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize + lead.phase;
+    let mut input = vec![0i16; silence];
+    input.extend_from_slice(samples);
+    let baked = crate::bake::bake(blob, &input).map_err(|e| EvalError::Device(e.to_string()))?;
     let poses = baked
         .play(blob)
         .map_err(|e| EvalError::Device(e.to_string()))?;
     let mut out = Playback::default();
-    for p in poses {
+    for p in poses.into_iter().skip(delay) {
         out.shown.push((p.segment, p.frame));
         out.poses.push(p.pose);
     }
@@ -271,6 +281,24 @@ mod tests {
         let (plain, _) =
             play_delayed(&blob, &silence, rate, frames, Lead::default(), |_| {}).unwrap();
         assert_eq!(plain.poses[..], whole.poses[..frames]);
+        // A whole-file plan likewise: the plan of the longer input, its lead cut off.
+        let lead_run = Lead {
+            frames: d,
+            phase: 53,
+        };
+        let baked = play_baked(&blob, &silence, rate, frames, lead_run).unwrap();
+        assert_eq!(baked.poses.len(), frames);
+        let plan = crate::bake::bake(&blob, &longer)
+            .unwrap()
+            .play(&blob)
+            .unwrap();
+        let shown: Vec<(usize, usize)> = plan.iter().map(|p| (p.segment, p.frame)).collect();
+        assert_eq!(baked.shown[..], shown[d..d + frames]);
+        assert!(baked
+            .poses
+            .iter()
+            .zip(&plan[d..])
+            .all(|(a, b)| *a == b.pose));
     }
 
     /// Known answer: run 0 has no lead; run `k` is `k` steps of frames and a phase under one
