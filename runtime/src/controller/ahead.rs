@@ -381,9 +381,9 @@ impl Ahead {
 mod tests {
     use super::*;
 
-    /// One segment of 100 frames at 30 fps whose stroke is frame 40.
-    struct Stroke;
-    impl LibraryFrames for Stroke {
+    /// One segment of 100 frames at 30 fps whose strokes are the frames listed.
+    struct Strokes(&'static [usize]);
+    impl LibraryFrames for Strokes {
         fn channels(&self) -> usize {
             1
         }
@@ -400,42 +400,24 @@ mod tests {
             f as f32
         }
         fn is_peak(&self, _: usize, f: usize) -> bool {
-            f == 40
+            self.0.contains(&f)
         }
     }
 
-    /// One segment of 100 frames at 30 fps with strokes at frames 40 and 48 (0.27 s apart).
-    struct TwoStrokes;
-    impl LibraryFrames for TwoStrokes {
-        fn channels(&self) -> usize {
-            1
-        }
-        fn fps(&self) -> f32 {
-            30.0
-        }
-        fn segment_count(&self) -> usize {
-            1
-        }
-        fn segment_len(&self, _: usize) -> usize {
-            100
-        }
-        fn value(&self, _: usize, f: usize, _: usize) -> f32 {
-            f as f32
-        }
-        fn is_peak(&self, _: usize, f: usize) -> bool {
-            f == 40 || f == 48
-        }
-    }
+    /// The stroke at frame 40.
+    const STROKE: Strokes = Strokes(&[40]);
+    /// Strokes at frames 40 and 48 (0.27 s apart).
+    const TWO_STROKES: Strokes = Strokes(&[40, 48]);
 
-    /// Plays `Stroke` from tick 0 with `ahead` steering the rate; the tick at which the
+    /// Plays [`STROKE`] from tick 0 with `ahead` steering the rate; the tick at which the
     /// stroke frame is first reached.
     fn stroke_tick(ahead: &mut Ahead) -> u64 {
         let mut player = Player::new();
         let mut out = [0.0; crate::player::MAX_CHANNELS];
         for now in 0..100u64 {
-            let r = ahead.stroke_rate(&Stroke, &player, now);
+            let r = ahead.stroke_rate(&STROKE, &player, now);
             player.set_rate(r);
-            player.tick(&Stroke, &mut out);
+            player.tick(&STROKE, &mut out);
             if out[0] >= 40.0 - 1e-3 {
                 return now;
             }
@@ -491,9 +473,9 @@ mod tests {
         let mut out = [0.0; crate::player::MAX_CHANNELS];
         let (mut first, mut second) = (None, None);
         for now in 0..100u64 {
-            let r = ahead.stroke_rate(&TwoStrokes, &player, now);
+            let r = ahead.stroke_rate(&TWO_STROKES, &player, now);
             player.set_rate(r);
-            player.tick(&TwoStrokes, &mut out);
+            player.tick(&TWO_STROKES, &mut out);
             if first.is_none() && out[0] >= 40.0 - 1e-3 {
                 first = Some(now);
             }
