@@ -311,14 +311,15 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
         };
         (w_mean(1, k + 1) * energy[0] * k as f32 + price(0) * k as f32 + rest_cost) / mean_interval
     };
-    cells[t0 * n + e0] = Cell {
-        cost: opening(t0),
+    let start = |k: usize| Cell {
+        cost: opening(k),
         prev: NONE,
         act: None,
         tick: 0,
         candidates: 0,
         chain: 0,
     };
+    cells[t0 * n + e0] = start(t0);
     // Segment 0 plays from the start. If the speech returns from a pause before its first
     // exit point, the plan may also decide then (at that exit point, which the player is
     // heading for: live, the speech's return decides at once), cutting from the frame shown;
@@ -327,14 +328,7 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
     let early = (0..t0)
         .find(|&k| !tl.resting_at(k) && k.checked_sub(1).map_or(silent, |j| tl.resting_at(j)));
     if let Some(k) = early {
-        cells[k * n + e0] = Cell {
-            cost: opening(k),
-            prev: NONE,
-            act: None,
-            tick: 0,
-            candidates: 0,
-            chain: 0,
-        };
+        cells[k * n + e0] = start(k);
     }
     // A state's entries once it is expanded (every way into it is known by then).
     let mut cand: Vec<(Act, f32, usize)> = Vec::new();

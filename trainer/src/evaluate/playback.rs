@@ -112,10 +112,7 @@ pub(crate) fn play_baked(
     lead: Lead,
 ) -> Result<Playback, EvalError> {
     let delay = lead.frames;
-    let silence =
-        (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize + lead.phase;
-    let mut input = vec![0i16; silence];
-    input.extend_from_slice(samples);
+    let input = lead.before(samples, rate, blob.fps());
     let baked = crate::bake::bake(blob, &input).map_err(|e| EvalError::Device(e.to_string()))?;
     let poses = baked
         .play(blob)
@@ -204,6 +201,15 @@ impl Lead {
             phase: ((run as f64 * GOLDEN).fract() * hop) as usize,
         }
     }
+
+    /// `samples` at `rate` Hz after the lead's silence, its frames at `fps`.
+    fn before(&self, samples: &[i16], rate: u32, fps: f32) -> Vec<i16> {
+        let silence =
+            (self.frames as f64 * rate as f64 / fps.max(1.0) as f64).round() as usize + self.phase;
+        let mut input = vec![0i16; silence];
+        input.extend_from_slice(samples);
+        input
+    }
 }
 
 /// The device's motion on `samples` after `lead` of silence, measured from the end of the
@@ -217,10 +223,7 @@ pub(crate) fn play_delayed(
     setup: impl FnOnce(&mut BlobController<'_>),
 ) -> Result<(Playback, Vec<Made>), EvalError> {
     let delay = lead.frames;
-    let silence =
-        (delay as f64 * rate as f64 / blob.fps().max(1.0) as f64).round() as usize + lead.phase;
-    let mut input = vec![0i16; silence];
-    input.extend_from_slice(samples);
+    let input = lead.before(samples, rate, blob.fps());
     let (mut p, made) = play_online(blob, &input, frames + delay, setup)?;
     p.poses.drain(..delay.min(p.poses.len()));
     p.shown.drain(..delay.min(p.shown.len()));
@@ -266,11 +269,11 @@ mod tests {
         let frames = (3.0 * fps) as usize;
         let silence = vec![0i16; 3 * rate as usize];
         let d = 7;
-        let lead = Lead {
+        let run_lead = Lead {
             frames: d,
             phase: 53,
         };
-        let (delayed, _) = play_delayed(&blob, &silence, rate, frames, lead, |_| {}).unwrap();
+        let (delayed, _) = play_delayed(&blob, &silence, rate, frames, run_lead, |_| {}).unwrap();
         assert_eq!(delayed.poses.len(), frames);
         let lead = (d as f64 * rate as f64 / fps).round() as usize + 53;
         let longer = vec![0i16; lead + silence.len()];
@@ -282,11 +285,7 @@ mod tests {
             play_delayed(&blob, &silence, rate, frames, Lead::default(), |_| {}).unwrap();
         assert_eq!(plain.poses[..], whole.poses[..frames]);
         // A whole-file plan likewise: the plan of the longer input, its lead cut off.
-        let lead_run = Lead {
-            frames: d,
-            phase: 53,
-        };
-        let baked = play_baked(&blob, &silence, rate, frames, lead_run).unwrap();
+        let baked = play_baked(&blob, &silence, rate, frames, run_lead).unwrap();
         assert_eq!(baked.poses.len(), frames);
         let plan = crate::bake::bake(&blob, &longer)
             .unwrap()
