@@ -76,20 +76,31 @@ pub fn bake(blob: &Blob<'_>, samples: &[i16]) -> Result<Baked, BakeError> {
     bake_with(blob, samples, &Weights::default())
 }
 
+/// [`bake`] of `samples` whose first `lead` ticks are a lead of silence outside the run (as
+/// `eval-motion` delays its runs): the variety lines count the ticks after it.
+pub fn bake_after(blob: &Blob<'_>, samples: &[i16], lead: u64) -> Result<Baked, BakeError> {
+    bake_run(blob, samples, &Weights::default(), lead)
+}
+
 /// [`bake`] with the whole file's own terms weighted by `w`.
 pub fn bake_with(blob: &Blob<'_>, samples: &[i16], w: &Weights) -> Result<Baked, BakeError> {
+    bake_run(blob, samples, w, 0)
+}
+
+/// [`bake_with`] with the variety lines counted from tick `from`.
+fn bake_run(blob: &Blob<'_>, samples: &[i16], w: &Weights, from: u64) -> Result<Baked, BakeError> {
     let rate = blob.prosody_config().sample_rate_hz;
     let fps_milli = (blob.fps() * 1000.0).round() as u64;
     let ticks = ticks_of(samples.len(), rate, fps_milli);
     let tl = Timeline::of(blob, samples, ticks as usize)?;
     let segments = LibraryFrames::segment_count(blob);
-    // The variety lines as constraints (dual ascent, see `variety`); the plan nearest them
-    // is kept.
+    // The variety lines as constraints (dual ascent, see `variety`) over the run; the plan
+    // nearest them is kept.
     let mut prices = Prices::new(segments);
     let mut kept: Option<((f32, f32), Vec<Planned>, f32)> = None;
     for _ in 0..price_rounds(ticks) {
         let (plan, cost) = plan::plan(blob, &tl, w, &prices.per_segment());
-        let played = Played::of(&plan, ticks, segments);
+        let played = Played::of(&plan, from, ticks, segments);
         let violation = played.violation();
         if kept.as_ref().is_none_or(|k| violation < k.0) {
             kept = Some((violation, plan, cost));

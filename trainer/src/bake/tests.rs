@@ -302,10 +302,10 @@ fn the_bake_plays_half_the_library_where_the_speech_has_room() {
     let (ticks, tl) = timeline(&blob, &speech);
     let n = LibraryFrames::segment_count(&blob);
     let (free, _) = plan::plan(&blob, &tl, &Weights::default(), &vec![0.0; n]);
-    let free = Played::of(&free, ticks, n);
+    let free = Played::of(&free, 0, ticks, n);
     assert_eq!(free.distinct_target(), DISTINCT_MIN, "{free:?}");
     assert!(free.distinct() < 0.4, "the free plan: {}", free.distinct());
-    let baked = Played::of(&bake(&blob, &speech).unwrap().plan, ticks, n);
+    let baked = Played::of(&bake(&blob, &speech).unwrap().plan, 0, ticks, n);
     assert!(
         baked.distinct() >= DISTINCT_MIN,
         "baked: {}",

@@ -9,6 +9,12 @@
 //!   earns a prize per tick (a negative price), in proportion to the shortfall, so the next
 //!   plan reaches for the ones it left out where they cost least.
 //!
+//! Both are counted over the run: the whole file, or from the end of a lead of silence that
+//! is not part of it ([`super::bake_after`]: `eval-motion` delays its runs by up to six
+//! seconds to vary where the speech meets the frames, and a plan that counted that silence
+//! held its waiting rest against the cap: on a ten-second span, planned within the 14 % cap,
+//! one segment played up to 21 % of the ten seconds).
+//!
 //! A plan cannot play more distinct segments than it enters, so of a short run, or a library
 //! larger than its entries, it is asked no more than one segment per entry
 //! ([`Played::distinct_target`]): prizes there would only buy entries the speech has no room
@@ -44,25 +50,27 @@ pub fn price_rounds(ticks: u64) -> usize {
     allowed.clamp(PRICE_ROUNDS as u64, MAX_PRICE_ROUNDS as u64) as usize
 }
 
-/// What a plan plays: each segment's share of the run, and how many segment entries it makes
-/// (the first segment, played from the start, counts as one).
+/// What a plan plays over the run: each segment's share of its ticks, and how many segment
+/// entries it makes there (the segment playing at the run's start counts as one).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Played {
-    /// Each segment's share of the ticks ([`shares`]).
+    /// Each segment's share of the run's ticks ([`shares`]).
     pub shares: Vec<f32>,
-    /// Segment entries, the first segment included.
+    /// Segment entries in the run, the segment playing at its start included.
     pub entries: usize,
 }
 
 impl Played {
-    /// What `plan` plays over `ticks` ticks of a library of `segments` segments.
-    pub fn of(plan: &[Planned], ticks: u64, segments: usize) -> Self {
+    /// What `plan` plays over ticks `from..ticks` (the run, after a lead of `from` ticks) of a
+    /// library of `segments` segments.
+    pub fn of(plan: &[Planned], from: u64, ticks: u64, segments: usize) -> Self {
         let entered = plan
             .iter()
+            .filter(|d| d.tick >= from)
             .filter(|d| matches!(d.act, Act::Enter { .. } | Act::Rest { .. }))
             .count();
         Self {
-            shares: shares(plan, ticks, segments),
+            shares: shares(plan, from, ticks, segments),
             entries: entered + 1,
         }
     }
@@ -140,29 +148,29 @@ impl Prices {
     }
 }
 
-/// Each segment's share of the `ticks` ticks a plan plays (a segment plays from the
-/// decision that enters it to the next that leaves it; before the first, segment 0).
-pub fn shares(plan: &[Planned], ticks: u64, segments: usize) -> Vec<f32> {
+/// Each segment's share of ticks `start..ticks` of a plan (a segment plays from the decision
+/// that enters it to the next that leaves it; before the first, segment 0).
+pub fn shares(plan: &[Planned], start: u64, ticks: u64, segments: usize) -> Vec<f32> {
+    let start = start.min(ticks);
     let mut played = vec![0u64; segments];
-    let (mut seg, mut from) = (0usize, 0u64);
+    let (mut seg, mut from) = (0usize, start);
     for d in plan {
         let next = match d.act {
             Act::Continue { .. } | Act::Hold => continue,
             Act::Enter { segment, .. } | Act::Rest { segment } => segment,
         };
+        let at = d.tick.clamp(start, ticks);
         if let Some(p) = played.get_mut(seg) {
-            *p += d.tick.min(ticks).saturating_sub(from);
+            *p += at.saturating_sub(from);
         }
         seg = next;
-        from = d.tick.min(ticks);
+        from = at;
     }
     if let Some(p) = played.get_mut(seg) {
         *p += ticks.saturating_sub(from);
     }
-    played
-        .iter()
-        .map(|&p| p as f32 / ticks.max(1) as f32)
-        .collect()
+    let span = (ticks - start).max(1) as f32;
+    played.iter().map(|&p| p as f32 / span).collect()
 }
 
 #[cfg(test)]
@@ -206,11 +214,33 @@ mod tests {
             planned(20, Act::Continue { rate: 0.9 }),
             planned(60, Act::Rest { segment: 2 }),
         ];
-        assert_eq!(shares(&plan, 100, 3), vec![0.1, 0.5, 0.4]);
-        let p = Played::of(&plan, 100, 3);
+        assert_eq!(shares(&plan, 0, 100, 3), vec![0.1, 0.5, 0.4]);
+        let p = Played::of(&plan, 0, 100, 3);
         assert_eq!(p.entries, 3);
         assert_eq!(p.largest(), 0.5);
         assert_eq!(p.distinct(), 1.0);
+    }
+
+    /// The same plan counted from tick 40 (after a lead of 40 ticks; 60 ticks): segment 1 plays
+    /// 20 of them, segment 2 the other 40; segment 0, left before the speech, plays none. Two
+    /// entries: segment 1, playing at the start, and the rest.
+    #[test]
+    fn shares_count_from_the_end_of_a_lead() {
+        let plan = [
+            enter(10, 1),
+            planned(20, Act::Continue { rate: 0.9 }),
+            planned(60, Act::Rest { segment: 2 }),
+        ];
+        let want = [0.0, 20.0 / 60.0, 40.0 / 60.0];
+        let got = shares(&plan, 40, 100, 3);
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-6, "{got:?}");
+        }
+        let p = Played::of(&plan, 40, 100, 3);
+        assert_eq!(p.entries, 2);
+        assert!((p.distinct() - 2.0 / 3.0).abs() < 1e-6);
+        // A start past the end counts nothing (and divides by no zero).
+        assert_eq!(shares(&plan, 200, 100, 3), vec![0.0, 0.0, 0.0]);
     }
 
     /// Ten segments, a plan that enters three of them four times (five entries with the
@@ -220,6 +250,7 @@ mod tests {
     fn the_distinct_target_is_half_the_library_or_one_per_entry() {
         let p = Played::of(
             &[enter(10, 1), enter(20, 2), enter(30, 1), enter(40, 2)],
+            0,
             100,
             10,
         );
@@ -228,7 +259,7 @@ mod tests {
         assert_eq!(p.distinct_target(), 0.5);
         let v = p.violation();
         assert!((v.1 - 0.2).abs() < 1e-6, "{v:?}");
-        let short = Played::of(&[enter(10, 1), enter(20, 2)], 100, 10);
+        let short = Played::of(&[enter(10, 1), enter(20, 2)], 0, 100, 10);
         assert!((short.distinct_target() - 0.3).abs() < 1e-6);
         assert_eq!(short.violation().1, 0.0);
     }

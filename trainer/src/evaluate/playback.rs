@@ -113,7 +113,8 @@ pub(crate) fn play_baked(
 ) -> Result<Playback, EvalError> {
     let delay = lead.frames;
     let input = lead.before(samples, rate, blob.fps());
-    let baked = crate::bake::bake(blob, &input).map_err(|e| EvalError::Device(e.to_string()))?;
+    let baked = crate::bake::bake_after(blob, &input, delay as u64)
+        .map_err(|e| EvalError::Device(e.to_string()))?;
     let poses = baked
         .play(blob)
         .map_err(|e| EvalError::Device(e.to_string()))?;
@@ -287,7 +288,7 @@ mod tests {
         // A whole-file plan likewise: the plan of the longer input, its lead cut off.
         let baked = play_baked(&blob, &silence, rate, frames, run_lead).unwrap();
         assert_eq!(baked.poses.len(), frames);
-        let plan = crate::bake::bake(&blob, &longer)
+        let plan = crate::bake::bake_after(&blob, &longer, d as u64)
             .unwrap()
             .play(&blob)
             .unwrap();
