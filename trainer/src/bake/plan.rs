@@ -256,6 +256,11 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
     for k in 0..t_end {
         wsum[k + 1] = wsum[k] + tl.weight[k] as f64;
     }
+    // Speaking ticks before each tick (a calm segment pays the rest cost for each it plays).
+    let mut spoken = vec![0u32; t_end + 2];
+    for k in 0..=t_end {
+        spoken[k + 1] = spoken[k] + u32::from(!tl.resting_at(k));
+    }
     let mut speaks = vec![t_end; t_end + 1];
     for k in (0..t_end).rev() {
         speaks[k] = if tl.resting[k] { speaks[k + 1] } else { k };
@@ -509,15 +514,18 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                             Act::Continue { .. } => e + 1,
                             _ => blob.first_exit(seg),
                         };
-                        let calm_speaking = !resting && energy[seg] <= rest.energy();
+                        let calm = energy[seg] <= rest.energy();
                         let t0 = t;
                         let t = tc;
                         for &rate in &RATES {
                             let t2 = t + lead + ticks_to(from, to, rate);
                             let dur = (t2 - t) as f32 / mean_interval;
                             let mut v = (w_mean(t + 1, t2 + 1) * energy[seg] + price(seg)) * dur;
-                            if calm_speaking {
-                                v += follow.rest_cost * dur;
+                            if calm {
+                                // Every tick it plays while the voice speaks, wherever decided.
+                                let (a, b) = ((t + 1).min(t_end + 1), (t2 + 1).min(t_end + 1));
+                                let speaking = spoken[b].saturating_sub(spoken[a]) as f32;
+                                v += follow.rest_cost * speaking / mean_interval;
                             }
                             v += pace_cost * rate.ln().abs();
                             // Strokes played on the way: frame f shows at tick t + lead +

@@ -196,14 +196,23 @@ fn the_blend_term_puts_the_peak_after_a_cut_on_an_onset() {
     );
 }
 
-/// The cut term is what puts cuts where the body is still: baked without it, the pose moves
-/// more at the ticks its cuts show.
+/// The cut term is what puts cuts where the body is still: planned without it, the pose moves
+/// more at the ticks its cuts show (one plan each, without the variety lines' prices, whose
+/// ascent plans again and moves cuts for its own reasons).
 #[test]
 fn the_cut_term_puts_cuts_where_the_body_is_still() {
     let (bytes, speech) = blob_and_speech();
     let blob = Blob::parse(&bytes).unwrap();
+    let (ticks, tl) = timeline(&blob, &speech);
     let at_cuts = |w: &Weights| -> f64 {
-        let b = bake_with(&blob, &speech, w).unwrap();
+        let (plan, cost) = plan::plan(&blob, &tl, w, &[]);
+        let commands = commands(&blob, &plan, ticks, &tl.gain);
+        let b = Baked {
+            plan,
+            cost,
+            commands,
+            ticks,
+        };
         let poses = b.play(&blob).unwrap();
         let cuts: Vec<usize> = b
             .commands
@@ -353,5 +362,43 @@ fn a_plan_can_leave_the_first_segment_at_the_first_syllable() {
         cut.tick as f64 <= first,
         "first cut at tick {}, onset {first}",
         cut.tick
+    );
+}
+
+/// Speech, a silence of 2.5, 3 or 3.5 s, speech: from half a second after the speech's return
+/// the baked body moves at least half as much as in the speech before. A calm segment pays the
+/// rest cost for every tick it plays while the voice speaks, whether chosen in the speech or
+/// in the silence before it: charged only when chosen in the speech, a rest chosen at an exit
+/// point just before the return played on through 0.5-1.5 s after it at 0.39 of the speech's
+/// motion (and on beat-scott held the hands still for 3 s of speech).
+#[test]
+fn the_baked_body_moves_again_when_the_speech_returns() {
+    let (bytes, speech) = blob_and_speech();
+    let blob = Blob::parse(&bytes).unwrap();
+    let rate = blob.prosody_config().sample_rate_hz as usize;
+    let fps_milli = (blob.fps() * 1000.0).round() as u64;
+    let tick = |sample: usize| (sample as u64 * fps_milli / (rate as u64 * 1000)) as usize;
+    let mut worst = f64::INFINITY;
+    for silence in [5 * rate / 2, 3 * rate, 7 * rate / 2] {
+        let half = speech.len().min(12 * rate);
+        let mut audio = speech[..half].to_vec();
+        audio.resize(audio.len() + silence, 0);
+        let back = audio.len();
+        audio.extend_from_slice(&speech[..half]);
+        let (_, tl) = timeline(&blob, &audio);
+        let poses = bake(&blob, &audio).unwrap().play(&blob).unwrap();
+        let speed = |span: std::ops::Range<usize>| -> f64 {
+            let n = span.len() as f64;
+            span.map(|k| pose_step(&poses, k)).sum::<f64>() / n
+        };
+        let speaking = speed(tick(rate)..tick(half));
+        let from = tick(back + rate / 2);
+        let after = speed(from..from + tick(rate));
+        assert!(!tl.resting_at(from), "the speech has returned at {from}");
+        worst = worst.min(after / speaking);
+    }
+    assert!(
+        worst > 0.5,
+        "after the speech returns: {worst:.2} of the speech's motion"
     );
 }
