@@ -16,7 +16,7 @@
 //! - **the voice**: the live energy term `w E_c`, with `w` averaged over the ticks the choice
 //!   plays (the live controller knows only the last syllable), in proportion to how long it
 //!   plays over the library's mean interval between exit points, and the live rest penalty for
-//!   a rest-like segment while speaking;
+//!   every tick a rest-like segment plays while the voice speaks, wherever it was chosen;
 //! - **strokes on syllables**: each library stroke (`library.peaks`) the choice plays earns
 //!   `STROKE_GAIN` times a Gaussian (sigma `STROKE_SIGMA_S`, the width of `eval-motion`'s beat
 //!   kernel) of its distance to the nearest syllable onset;
