@@ -94,7 +94,7 @@ pub const RATES: [f32; 5] = [0.8, 0.9, 1.0, 1.12, 1.25];
 /// Cost per unit of `|ln rate|` of a choice.
 pub const PACE_COST: f32 = 1.0;
 /// What a stroke on a syllable onset earns (cost units).
-pub const STROKE_GAIN: f32 = 1.5;
+pub const STROKE_GAIN: f32 = 2.0;
 /// Width of the stroke-to-onset kernel (s).
 pub const STROKE_SIGMA_S: f64 = 0.1;
 /// What the speed peak after a cut earns, as a share of a stroke's gain (see
