@@ -205,15 +205,20 @@ mod tests {
         assert_eq!(price_rounds(0), 32);
     }
 
+    /// Segment 1 entered at tick 10 and continued at 20, rest segment 2 from 60.
+    fn three_segments() -> [Planned; 3] {
+        [
+            enter(10, 1),
+            planned(20, Act::Continue { rate: 0.9 }),
+            planned(60, Act::Rest { segment: 2 }),
+        ]
+    }
+
     /// Shares of a plan, counted by hand: segment 0 until tick 10, segment 1 (continued at 20)
     /// until 60, segment 2 to the end (100 ticks); three entries, the first segment included.
     #[test]
     fn shares_count_each_segment_from_its_entry_to_the_next() {
-        let plan = [
-            enter(10, 1),
-            planned(20, Act::Continue { rate: 0.9 }),
-            planned(60, Act::Rest { segment: 2 }),
-        ];
+        let plan = three_segments();
         assert_eq!(shares(&plan, 0, 100, 3), vec![0.1, 0.5, 0.4]);
         let p = Played::of(&plan, 0, 100, 3);
         assert_eq!(p.entries, 3);
@@ -222,15 +227,11 @@ mod tests {
     }
 
     /// The same plan counted from tick 40 (after a lead of 40 ticks; 60 ticks): segment 1 plays
-    /// 20 of them, segment 2 the other 40; segment 0, left before the speech, plays none. Two
+    /// 20 of them, segment 2 the other 40; segment 0, left during the lead, plays none. Two
     /// entries: segment 1, playing at the start, and the rest.
     #[test]
     fn shares_count_from_the_end_of_a_lead() {
-        let plan = [
-            enter(10, 1),
-            planned(20, Act::Continue { rate: 0.9 }),
-            planned(60, Act::Rest { segment: 2 }),
-        ];
+        let plan = three_segments();
         let want = [0.0, 20.0 / 60.0, 40.0 / 60.0];
         let got = shares(&plan, 40, 100, 3);
         for (g, w) in got.iter().zip(want) {
