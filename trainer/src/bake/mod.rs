@@ -50,6 +50,19 @@ pub struct Baked {
     pub ticks: u64,
 }
 
+impl Baked {
+    /// `plan` (of total `cost`, over `ticks` ticks of `tl`) as the player's commands.
+    fn of(blob: &Blob<'_>, plan: Vec<Planned>, cost: f32, tl: &Timeline, ticks: u64) -> Self {
+        let commands = commands(blob, &plan, ticks, &tl.gain);
+        Self {
+            plan,
+            cost,
+            commands,
+            ticks,
+        }
+    }
+}
+
 /// One pose of a baked run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BakedPose {
@@ -111,13 +124,7 @@ fn bake_run(blob: &Blob<'_>, samples: &[i16], w: &Weights, from: u64) -> Result<
         prices.raise(&played);
     }
     let (_, plan, cost) = kept.unwrap_or(((0.0, 0.0), Vec::new(), 0.0));
-    let commands = commands(blob, &plan, ticks, &tl.gain);
-    Ok(Baked {
-        plan,
-        cost,
-        commands,
-        ticks,
-    })
+    Ok(Baked::of(blob, plan, cost, &tl, ticks))
 }
 
 /// The player's commands that carry out `plan` over `ticks` ticks: each decision's after the

@@ -308,7 +308,7 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
     let e0 = blob.first_exit(0);
     let t0 = blob.exit_frame(e0).min(t_end);
     let opening = |k: usize| {
-        let speaking = (0..k).filter(|&j| !tl.resting_at(j + 1)).count() as f32;
+        let speaking = spoken[(k + 1).min(t_end + 1)].saturating_sub(spoken[1]) as f32;
         let rest_cost = if energy[0] <= rest.energy() {
             follow.rest_cost * speaking
         } else {

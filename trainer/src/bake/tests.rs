@@ -44,6 +44,29 @@ fn blob_and_speech_with(opts: &PackOptions) -> (Vec<u8>, Vec<i16>) {
     (packed.bytes, speech)
 }
 
+/// Up to 12 s of `speech`, `silence` samples of silence, the same speech again; and where the
+/// silence starts and where the speech returns (samples).
+fn speech_silence_speech(speech: &[i16], rate: usize, silence: usize) -> (Vec<i16>, usize, usize) {
+    let half = speech.len().min(12 * rate);
+    let mut audio = speech[..half].to_vec();
+    audio.resize(half + silence, 0);
+    audio.extend_from_slice(&speech[..half]);
+    (audio, half, half + silence)
+}
+
+/// The tick of sample `sample` for `blob` (rounded down).
+fn tick_of(blob: &Blob<'_>, sample: usize) -> usize {
+    let rate = blob.prosody_config().sample_rate_hz as u64;
+    let fps_milli = (blob.fps() * 1000.0).round() as u64;
+    (sample as u64 * fps_milli / (rate * 1000)) as usize
+}
+
+/// Mean change of the pose per tick (degrees over channels) over a span of ticks.
+fn mean_step(poses: &[BakedPose], span: std::ops::Range<usize>) -> f64 {
+    let n = span.len() as f64;
+    span.map(|k| pose_step(poses, k)).sum::<f64>() / n
+}
+
 /// The ticks `speech` spans for `blob` and its timeline.
 fn timeline(blob: &Blob<'_>, speech: &[i16]) -> (u64, Timeline) {
     let rate = blob.prosody_config().sample_rate_hz;
@@ -92,11 +115,7 @@ fn a_baked_run_rests_in_a_silence() {
     let (bytes, speech) = blob_and_speech();
     let blob = Blob::parse(&bytes).unwrap();
     let rate = blob.prosody_config().sample_rate_hz as usize;
-    let half = speech.len().min(12 * rate);
-    let mut audio = speech[..half].to_vec();
-    let silence_at = audio.len();
-    audio.resize(audio.len() + 4 * rate, 0);
-    audio.extend_from_slice(&speech[..half]);
+    let (audio, silence_at, _) = speech_silence_speech(&speech, rate, 4 * rate);
     let baked = bake(&blob, &audio).unwrap();
     let fps_milli = (blob.fps() * 1000.0).round() as u64;
     assert_eq!(baked.ticks, ticks_of(audio.len(), rate as u32, fps_milli));
@@ -116,12 +135,8 @@ fn a_baked_run_rests_in_a_silence() {
             );
         }
     }
-    let tick = |sample: usize| (sample as u64 * fps_milli / (rate as u64 * 1000)) as usize;
-    // Mean change of the pose per tick (degrees over channels) over a span of ticks.
-    let speed = |span: std::ops::Range<usize>| -> f64 {
-        let n = span.len() as f64;
-        span.map(|k| pose_step(&poses, k)).sum::<f64>() / n
-    };
+    let tick = |sample: usize| tick_of(&blob, sample);
+    let speed = |span: std::ops::Range<usize>| mean_step(&poses, span);
     // From 1.5 s into the silence to its end, against the speech before it.
     let quiet = speed(tick(silence_at + 3 * rate / 2)..tick(silence_at + 4 * rate));
     let speaking = speed(tick(rate)..tick(silence_at));
@@ -206,13 +221,7 @@ fn the_cut_term_puts_cuts_where_the_body_is_still() {
     let (ticks, tl) = timeline(&blob, &speech);
     let at_cuts = |w: &Weights| -> f64 {
         let (plan, cost) = plan::plan(&blob, &tl, w, &[]);
-        let commands = commands(&blob, &plan, ticks, &tl.gain);
-        let b = Baked {
-            plan,
-            cost,
-            commands,
-            ticks,
-        };
+        let b = Baked::of(&blob, plan, cost, &tl, ticks);
         let poses = b.play(&blob).unwrap();
         let cuts: Vec<usize> = b
             .commands
@@ -376,21 +385,13 @@ fn the_baked_body_moves_again_when_the_speech_returns() {
     let (bytes, speech) = blob_and_speech();
     let blob = Blob::parse(&bytes).unwrap();
     let rate = blob.prosody_config().sample_rate_hz as usize;
-    let fps_milli = (blob.fps() * 1000.0).round() as u64;
-    let tick = |sample: usize| (sample as u64 * fps_milli / (rate as u64 * 1000)) as usize;
+    let tick = |sample: usize| tick_of(&blob, sample);
     let mut worst = f64::INFINITY;
     for silence in [5 * rate / 2, 3 * rate, 7 * rate / 2] {
-        let half = speech.len().min(12 * rate);
-        let mut audio = speech[..half].to_vec();
-        audio.resize(audio.len() + silence, 0);
-        let back = audio.len();
-        audio.extend_from_slice(&speech[..half]);
+        let (audio, half, back) = speech_silence_speech(&speech, rate, silence);
         let (_, tl) = timeline(&blob, &audio);
         let poses = bake(&blob, &audio).unwrap().play(&blob).unwrap();
-        let speed = |span: std::ops::Range<usize>| -> f64 {
-            let n = span.len() as f64;
-            span.map(|k| pose_step(&poses, k)).sum::<f64>() / n
-        };
+        let speed = |span: std::ops::Range<usize>| mean_step(&poses, span);
         let speaking = speed(tick(rate)..tick(half));
         let from = tick(back + rate / 2);
         let after = speed(from..from + tick(rate));
