@@ -154,3 +154,35 @@ fn labels_queue_and_unknown_ones_are_refused() {
     let mut c = BlobController::from_blob(&blob).unwrap();
     assert!(matches!(c.push_label(0), Err(LabelError::Unknown { .. })));
 }
+
+#[test]
+fn a_label_asked_for_while_the_body_rests_is_answered_at_once() {
+    // One second of speech, then three of silence: the body rests (the blob rests after
+    // 750 ms, segment 0 is its calmest). `bye` (segment 1) is asked for 1.5 s into the
+    // silence, at tick 75 (30 fps): it is entered within two ticks, not when the speech
+    // returns or the label times out.
+    let bytes = labelled();
+    let blob = Blob::parse(&bytes).unwrap();
+    let mut c = BlobController::from_blob(&blob).unwrap();
+    let mut samples = speech(1.0);
+    samples.resize(4 * 16_000, 0);
+    let mut out = Vec::new();
+    let mut shown = Vec::new();
+    c.push(&samples[..40_000], &mut |e| record(e, &mut out, &mut shown));
+    assert_eq!(shown.last().map(|s| s.0), Some(0), "resting in segment 0");
+    let asked = shown.len() as u64;
+    c.push_label(1).unwrap();
+    c.push(&samples[40_000..], &mut |e| record(e, &mut out, &mut shown));
+    let entered = out.iter().find_map(|r| match *r {
+        Rec::Label(t, 1, LabelOutcome::Entered { segment: 1, .. }) => Some(t),
+        _ => None,
+    });
+    let entered = entered.unwrap_or_else(|| panic!("never entered: {out:?}"));
+    assert!(
+        entered >= asked && entered - asked <= 2,
+        "asked at tick {asked}, entered at {entered}"
+    );
+    assert!(out
+        .iter()
+        .any(|r| matches!(r, Rec::Label(_, 1, LabelOutcome::Stroke))));
+}

@@ -466,7 +466,18 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             return;
         }
         if self.voice.resting() && self.rest.contains(segment) && self.deferred.is_none() {
-            self.hold_rest(segment, tick, sink);
+            if self.labels.waiting().is_some() {
+                // A label asked for while the body rests (a button, a chat bot) is answered at
+                // once, as the speech's return is: a rest has no exit point it must reach.
+                let (e, reached) = match self.waiting.take() {
+                    Some(e) => (e, true),
+                    None => (self.exit, false),
+                };
+                self.waited = 0;
+                self.decide_with(e, tick, reached, sink);
+            } else {
+                self.hold_rest(segment, tick, sink);
+            }
             return;
         }
         let t = self.timing;
