@@ -469,12 +469,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             if self.labels.waiting().is_some() {
                 // A label asked for while the body rests (a button, a chat bot) is answered at
                 // once, as the speech's return is: a rest has no exit point it must reach.
-                let (e, reached) = match self.waiting.take() {
-                    Some(e) => (e, true),
-                    None => (self.exit, false),
-                };
-                self.waited = 0;
-                self.decide_with(e, tick, reached, sink);
+                self.decide_now(tick, sink);
             } else {
                 self.hold_rest(segment, tick, sink);
             }
@@ -667,13 +662,19 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
         }
         // A cut still waiting for the hands was decided for the speech: decide again.
         self.deferred = None;
+        self.decide_now(tick, sink);
+        true
+    }
+
+    /// Decides at once at the exit point the controller is armed at (waiting for an onset) or
+    /// heading for.
+    fn decide_now(&mut self, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
         let (e, reached) = match self.waiting.take() {
             Some(e) => (e, true),
             None => (self.exit, false),
         };
         self.waited = 0;
         self.decide_with(e, tick, reached, sink);
-        true
     }
 
     /// Decides at exit `e` (reached) and acts on it.
