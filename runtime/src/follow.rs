@@ -25,7 +25,12 @@
 //!   (`defer_cut_ms`), so the playing gesture is left between strokes. The rest motion is the
 //!   library's own: its calmest segments, breathing and drifting as the capture did; once one
 //!   is entered it holds until the speech returns, played to and fro (the player turns at its
-//!   ends: no cut, no freeze).
+//!   ends: no cut, no freeze). A rest **holds the posture** the gesture paused in: it begins
+//!   at its calm frame nearest the pose shown, plays to and fro among its calm frames (at
+//!   least half a second of them), and the posture drifts into the rest's own at a twentieth
+//!   of the library's speed cap ([`REST_BLEND`](crate::player::REST_BLEND)). Blended in at a
+//!   gesture's pace, the rest's posture (arms lowered, or spread in a monologue's calmest
+//!   segment) was a second movement a second into the pause, as fast as a gesture.
 //! - **speaking**: `w = -energy_cost * clamp(level / VOICE_SPAN, -1, 1)`, `level` the last
 //!   syllable's intensity relative to the speaker's running level (the CRF's own step feature,
 //!   in 10 dB units): louder than usual favours energetic segments, quieter calm ones. And the

@@ -67,7 +67,14 @@ impl PolicyTables for Tables {
     }
 }
 
-struct Lib;
+/// The frames: segment `c`'s frame `f` holds pose `100 c + f`. With `partly_calm`, the
+/// calmest segment (2) is calm only in frames 10-19 and its frames hold poses 150 down to 121,
+/// so the one nearest a gesture's pose is known.
+struct Lib {
+    partly_calm: bool,
+}
+
+const LIB: Lib = Lib { partly_calm: false };
 
 impl LibraryFrames for Lib {
     fn channels(&self) -> usize {
@@ -83,11 +90,17 @@ impl LibraryFrames for Lib {
         LENS[c]
     }
     fn value(&self, c: usize, f: usize, _ch: usize) -> f32 {
-        (c * 100 + f) as f32
+        match c {
+            2 if self.partly_calm => 150.0 - f as f32,
+            _ => (c * 100 + f) as f32,
+        }
     }
     /// The calm segments' frames are calm (as `pack` marks the slowest frames).
-    fn is_calm(&self, c: usize, _f: usize) -> bool {
-        ENERGY[c] < 0.0
+    fn is_calm(&self, c: usize, f: usize) -> bool {
+        match c {
+            2 if self.partly_calm => (10..20).contains(&f),
+            _ => ENERGY[c] < 0.0,
+        }
     }
     /// The gestures' hands pause every 8 frames (their speed's local minima).
     fn is_beat(&self, _c: usize, f: usize) -> bool {
@@ -131,6 +144,15 @@ fn run(samples: &[i16], follow: VoiceFollow) -> Vec<Tick> {
 }
 
 fn run_with(samples: &[i16], follow: VoiceFollow, variety: Variety) -> Vec<Tick> {
+    run_lib(samples, follow, variety, &LIB)
+}
+
+fn run_lib(
+    samples: &[i16],
+    follow: VoiceFollow,
+    variety: Variety,
+    lib: &impl LibraryFrames,
+) -> Vec<Tick> {
     let t = Tables::new();
     let mut bytes = Vec::new();
     for v in [0i16, 0, 0, 0] {
@@ -146,7 +168,7 @@ fn run_with(samples: &[i16], follow: VoiceFollow, variety: Variety) -> Vec<Tick>
     )
     .unwrap();
     let g = [GmmComponent::default(), GmmComponent::default()];
-    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, &Lib).unwrap();
+    let mut c = Controller::new(&ProsodyConfig::DEFAULT, &g, crf, &t, lib).unwrap();
     c.set_variety(variety);
     c.set_follow(follow);
     let mut ticks: Vec<Tick> = Vec::new();
@@ -240,6 +262,40 @@ fn a_pause_brings_the_calmest_segments_held_to_and_fro_until_the_speech_returns(
 }
 
 #[test]
+fn a_rest_begins_at_its_calm_frame_nearest_the_pose_and_stays_among_its_calm_frames() {
+    // Speech 0-3 s, silence 3-9 s.
+    let samples = audio(9.0, |t| t < 3.0);
+    let ticks = run_lib(&samples, FOLLOW, Variety::NONE, &Lib { partly_calm: true });
+    let first = ticks.iter().position(|t| rest(t.segment)).unwrap();
+    assert_eq!(ticks[first].segment, 2);
+    // Entered at the calm frame (10-19) whose pose (150 - f) is nearest the pose shown just
+    // before the cut.
+    let before = ticks[first - 1].pose;
+    let nearest = (10..20usize)
+        .min_by(|&a, &b| {
+            let d = |f: usize| (150.0 - f as f32 - before).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .unwrap();
+    assert_eq!(ticks[first].frame, nearest, "pose before the cut {before}");
+    // Held to and fro among the calm frames widened to half a second (15 frames): 7-22,
+    // never at the segment's restless ends, and never frozen.
+    let held = &ticks[first..];
+    assert!(held.iter().all(|t| t.segment == 2));
+    assert!(
+        held.iter().all(|t| (7..=22).contains(&t.frame)),
+        "{:?}",
+        held.iter().map(|t| t.frame).collect::<Vec<_>>()
+    );
+    assert!(held.windows(2).any(|w| w[1].frame < w[0].frame));
+    assert!(held.windows(2).any(|w| w[1].frame > w[0].frame));
+    assert!(held.iter().any(|t| t.frame == 7) && held.iter().any(|t| t.frame == 22));
+    for w in held.windows(3) {
+        assert!(w[0].pose != w[1].pose || w[1].pose != w[2].pose);
+    }
+}
+
+#[test]
 fn a_rest_held_through_a_long_pause_hands_over_to_the_other_rest() {
     // Speech 0-3 s, silence 3-15 s. A usage window of 20 s: a rest hands over once it has
     // held for 0.14 of it (2.8 s), at its next turn.
@@ -260,8 +316,7 @@ fn a_rest_held_through_a_long_pause_hands_over_to_the_other_rest() {
     }
     // Each hold lasts at least 2.8 s, and at most that and one more traversal of the longest
     // rest to a turn at the rest's slowest pace (30 frames at half speed: 2 s); a hold hands
-    // over to the other rest at one of its ends, into the other's first frame, with no
-    // decision.
+    // over to the other rest at one of its ends, with no decision.
     let mut holds = vec![(first_rest, ticks[first_rest].segment)];
     for (i, w) in ticks.windows(2).enumerate().skip(first_rest) {
         if w[1].segment != w[0].segment {
@@ -269,7 +324,11 @@ fn a_rest_held_through_a_long_pause_hands_over_to_the_other_rest() {
             // The frame shown last is next to an end (the player has reached it).
             let len = LENS[w[0].segment];
             assert!(w[0].frame <= 1 || w[0].frame + 2 >= len, "{w:?}");
-            assert_eq!(w[1].frame, 0);
+            // Into the other's frame nearest the pose shown (all its frames are calm).
+            let c = w[1].segment;
+            let d = |f: usize| (LIB.value(c, f, 0) - w[0].pose).abs();
+            let nearest = (0..LENS[c]).min_by(|&a, &b| d(a).total_cmp(&d(b))).unwrap();
+            assert_eq!(w[1].frame, nearest, "{w:?}");
             assert!(!w[1].decided);
             holds.push((i + 1, w[1].segment));
         }

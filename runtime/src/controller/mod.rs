@@ -65,6 +65,7 @@ mod ahead;
 mod build;
 mod event;
 mod labels;
+mod rest_entry;
 mod resting;
 mod settings;
 
@@ -84,6 +85,7 @@ pub use ahead::{Lookahead, MAX_LOOKAHEAD_MS};
 pub use event::{ControllerError, ControllerEvent, LabelOutcome};
 use labels::Labels;
 pub use labels::{LabelError, LABEL_QUEUE};
+pub use rest_entry::{rest_entry, RestEntry, REST_PROBES, REST_SPAN};
 
 use crate::prosody::arith::{Arith, DefaultArith};
 use crate::prosody::{Event, FrontEnd, ProsodyConfig};
@@ -173,6 +175,8 @@ pub struct Controller<
     rest: RestSet,
     /// The tick the last rest began.
     rest_since: u32,
+    /// The frames of the rest segment entered last that a rest plays to and fro between.
+    rest_span: (u16, u16),
     /// Length of a pause step (ms).
     pause_ms: u32,
     /// The segment and frame shown at the last tick.
@@ -226,6 +230,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
             voice: Voice::new(),
             rest: RestSet::EMPTY,
             rest_since: 0,
+            rest_span: (0, u16::MAX),
             pause_ms: config.syllables.pause_frames.saturating_mul(10),
             ahead: Ahead::new(),
             last_shown: (0, 0),
@@ -610,6 +615,11 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
 
     /// Cuts to segment `c` at frame `f` now.
     fn cut(&mut self, c: usize, f: usize, tick: u64, sink: &mut impl FnMut(ControllerEvent<'_>)) {
+        let f = if self.voice.resting() && self.rest.contains(c) && f == 0 {
+            self.begin_rest(c)
+        } else {
+            f
+        };
         self.player.enter_at(self.lib, c, f);
         let command = PlayerCommand::Enter {
             segment: self.player.segment().min(u16::MAX as usize) as u16,

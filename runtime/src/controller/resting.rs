@@ -2,6 +2,7 @@
 //! `crate::follow`), and handed over to another rest once it has held for long
 //! ([`HOLD_SHARE`]).
 
+use super::rest_entry::rest_entry;
 use super::{Controller, ControllerEvent};
 use crate::player::{LibraryFrames, PlayerCommand};
 use crate::policy::{Penalties, PolicyTables};
@@ -19,14 +20,17 @@ impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'
         tick: u64,
         sink: &mut impl FnMut(ControllerEvent<'_>),
     ) {
-        let at_end = !self.player.backward() && self.player.at_end(self.lib);
-        let turning = at_end || self.player.position() <= 0.0;
+        let (lo, hi) = self.rest_span;
+        let at_end = !self.player.backward()
+            && (self.player.at_end(self.lib) || self.player.frame() >= hi as usize);
+        let at_start = self.player.position() <= lo as f32;
+        let turning = at_end || at_start;
         if let Some(c) = turning
             .then(|| self.rest_hand_over(segment, tick))
             .flatten()
         {
             self.cut(c, 0, tick, sink);
-        } else if at_end {
+        } else if at_end || (at_start && self.player.backward()) {
             self.player.turn();
             self.play(PlayerCommand::Turn, sink);
         }
@@ -53,5 +57,15 @@ impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'
         }
         let p = Penalties::new(v, &self.history, now, 0, window);
         self.rest.hand_over(segment, |c| p.usage_of(c))
+    }
+
+    /// Where a rest in segment `c` begins ([`rest_entry`] from the pose just shown); the
+    /// span it plays to and fro in is kept for [`hold_rest`](Self::hold_rest).
+    pub(super) fn begin_rest(&mut self, c: usize) -> usize {
+        let n = self.lib.channels().min(self.pose.len());
+        let e = rest_entry(self.lib, c, &self.pose[..n]);
+        let clip = |f: usize| f.min(u16::MAX as usize) as u16;
+        self.rest_span = (clip(e.span.0), clip(e.span.1));
+        e.frame
     }
 }

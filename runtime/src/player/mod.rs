@@ -28,8 +28,11 @@
 //! frames and back, a hand step of 28 cm in one frame. Within the library's 99th-percentile
 //! speed the pose's velocity is continuous across a cut as before. A cut into one of the
 //! library's rest segments ([`Player::set_rest_segments`]: the character comes to rest in a
-//! pause) blends at [`REST_BLEND`] of the cap: arms lowered at a gesture's pace read as
-//! dropped, and the hands moved fastest just as the speech stopped.
+//! pause) drifts in at [`REST_BLEND`] of the cap, stretched up to [`REST_STRETCH`] times the
+//! blend time, while the velocity it carries dies out over the blend time as at any cut (the
+//! offset and the velocity then decay at two paces, each a third-order response): arms
+//! lowered at a gesture's pace read as dropped, and moved a second into a pause as fast as a
+//! gesture; carried over the long drift, the velocity would coast on for a second.
 //!
 //! Channels are blended as what they are:
 //! - a single angle (a servo, a twist, one Euler angle of a puppet): offset in degrees, linear
@@ -85,11 +88,18 @@ const PEAK: f32 = 2.0 / (core::f32::consts::E * core::f32::consts::E);
 /// multiple of the set blend time.
 pub const MAX_BLEND_STRETCH: u32 = 3;
 
-/// The share of the speed cap a cut into a rest segment blends at (see the module docs):
-/// chosen on the shared takes, where the hands' coupling to the voice rose on the 067 take
-/// (9-joint model and library) from +0.344 to +0.376 at 0.5 and +0.381 at 0.3 and stayed
-/// within 0.005 elsewhere (the blend is stretched at most [`MAX_BLEND_STRETCH`] times).
-pub const REST_BLEND: f32 = 0.5;
+/// The share of the speed cap a cut into a rest segment drifts in at (see the module docs):
+/// the posture the gesture paused in is held and eases into the rest's over seconds. On the
+/// shared takes, half the cap (stretched at most 3 times) moved the hands a second into each
+/// pause as fast as a gesture; a twentieth (stretched at most [`REST_STRETCH`] times) and
+/// holding the posture outright gave the same coupling and settling within 0.01 (30 runs;
+/// docs/method.md), and 0.15 over at most 4 s left the hands drifting at 15-20 cm/s for
+/// seconds (the 001 take with the 067 library: a third of their speaking speed).
+pub const REST_BLEND: f32 = 0.05;
+
+/// The longest a cut into a rest segment is stretched, as a multiple of the set blend time
+/// (10 s at the default 400 ms).
+pub const REST_STRETCH: u32 = 25;
 
 /// The slowest playback rate (frames per tick): half the library's pace. Calm motion at half
 /// speed still reads as breathing and drift; slower, it reads as slow motion.
@@ -163,6 +173,9 @@ pub struct Player {
     blend_ticks: u32,
     /// This cut's blend time: `blend_ticks`, stretched for a large offset.
     cut_ticks: u32,
+    /// The time over which this cut's carried velocity decays: `cut_ticks`, or for a cut
+    /// into a rest `blend_ticks` (the offset itself drifts out slower, [`REST_BLEND`]).
+    vel_ticks: u32,
     /// Fastest the offset may move (degrees per tick at its start; 0: no cap).
     speed_cap: f32,
     blending: bool,
@@ -193,6 +206,7 @@ impl Player {
             since: 0,
             blend_ticks: 0,
             cut_ticks: 0,
+            vel_ticks: 0,
             speed_cap: 0.0,
             blending: false,
             rate: 1.0,
@@ -328,6 +342,7 @@ impl Player {
         self.backward = false;
         self.since = 0;
         self.cut_ticks = self.blend_ticks;
+        self.vel_ticks = self.blend_ticks;
         self.blending = self.blend_ticks > 0 && self.outputs > 0;
         let n = lib.channels().min(MAX_CHANNELS);
         let moving = self.outputs > 1;
@@ -416,16 +431,20 @@ impl Player {
             // tick: keep that within the cap.
             // The offset x0 (1 + a t + (a t)^2 / 2) e^(-a t) moves fastest at t = 2 / a, by
             // 2 a x0 / e^2 per tick: keep that within the cap.
-            let cap = if self.rest.contains(c) {
-                self.speed_cap * REST_BLEND
+            let rest = self.rest.contains(c);
+            let (cap, stretch) = if rest {
+                (self.speed_cap * REST_BLEND, REST_STRETCH)
             } else {
-                self.speed_cap
+                (self.speed_cap, MAX_BLEND_STRETCH)
             };
             let need = SETTLE * largest * PEAK / cap;
-            let most = self.blend_ticks.saturating_mul(MAX_BLEND_STRETCH);
+            let most = self.blend_ticks.saturating_mul(stretch);
             if need.is_finite() && need > self.blend_ticks as f32 {
                 // Between blend_ticks (need is above it) and most.
                 self.cut_ticks = libm::ceilf(need.min(most as f32)) as u32;
+            }
+            if !rest {
+                self.vel_ticks = self.cut_ticks;
             }
         }
     }
@@ -506,8 +525,18 @@ impl Player {
             // Tick 1 is the first frame of the new segment (the offset is from tick 0).
             let t = (self.since + 1) as f32;
             let decay = libm::expf(-a * t);
+            // A cut into a rest: the velocity decays at the blend's own pace (`b`), the offset
+            // slower; otherwise both at `a`, as one response.
+            let split = self.vel_ticks != self.cut_ticks;
+            let b = SETTLE / self.vel_ticks.max(1) as f32;
+            let fast = if split { libm::expf(-b * t) } else { decay };
             let spring = |x0: f32, v0: f32| {
-                (x0 + (v0 + a * x0) * t + (a * v0 + 0.5 * a * a * x0) * t * t) * decay
+                if split {
+                    (x0 + a * x0 * t + 0.5 * a * a * x0 * t * t) * decay
+                        + (v0 * t + b * v0 * t * t) * fast
+                } else {
+                    (x0 + (v0 + a * x0) * t + (a * v0 + 0.5 * a * a * x0) * t * t) * decay
+                }
             };
             left = spring(1.0, 0.0);
             for (ch, o) in out.iter_mut().enumerate().take(n) {

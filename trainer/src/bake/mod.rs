@@ -25,9 +25,10 @@ pub mod variety;
 pub use error::BakeError;
 
 use gesture_runtime::blob::Blob;
+use gesture_runtime::controller::rest_entry;
 use gesture_runtime::follow::{rest_rate, rest_segments, RestSet};
 use gesture_runtime::player::{
-    library_speed_cap, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
+    library_speed_cap, within_limits, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
 };
 use gesture_runtime::policy::PolicyTables;
 use gesture_runtime::show::{encode, Show, ShowPlayer};
@@ -154,6 +155,7 @@ fn commands(
     let (mut next, mut applied) = (0usize, 0usize);
     let mut rate = 1.0f32;
     let mut rest_until = 0u64;
+    let mut span = (0usize, usize::MAX);
     for k in 0..ticks {
         if let Some(&(at_rest, in_gesture)) = gain.get(k as usize) {
             let g = if rest.contains(player.segment()) {
@@ -170,7 +172,11 @@ fn commands(
             applied += 1;
         }
         player.tick(blob, &mut pose);
-        if k + 1 < rest_until && !player.backward() && player.at_end(blob) {
+        // A rest plays to and fro among its calm frames (`rest_entry`), as the controller's.
+        let (lo, hi) = span;
+        let at_end = !player.backward() && (player.at_end(blob) || player.frame() >= hi);
+        let at_start = player.backward() && player.position() <= lo as f32;
+        if k + 1 < rest_until && (at_end || at_start) {
             out.push((k + 1, PlayerCommand::Turn));
         }
         while next < plan.len() && plan[next].tick <= k {
@@ -212,9 +218,15 @@ fn commands(
                 }
                 Act::Hold => rest_until = d.until,
                 Act::Rest { segment: r } => {
+                    // From the pose shown, within the rig's limits as the controller's is.
+                    let mut shown = pose;
+                    within_limits(blob, &mut shown);
+                    let n = LibraryFrames::channels(blob).min(MAX_CHANNELS);
+                    let entry = rest_entry(blob, r, &shown[..n]);
+                    span = entry.span;
                     give(PlayerCommand::Enter {
                         segment: r.min(u16::MAX as usize) as u16,
-                        frame: 0,
+                        frame: entry.frame.min(u16::MAX as usize) as u16,
                     });
                     pace(rest_rate(blob.energy(r)), &mut give);
                     rest_until = d.until;
