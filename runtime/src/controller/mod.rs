@@ -85,7 +85,7 @@ pub use ahead::{Lookahead, MAX_LOOKAHEAD_MS};
 pub use event::{ControllerError, ControllerEvent, LabelOutcome};
 use labels::Labels;
 pub use labels::{LabelError, LABEL_QUEUE};
-pub use rest_entry::{rest_entry, RestEntry, REST_PROBES, REST_SPAN};
+pub use rest_entry::{rest_entry, span_ends, RestEntry, REST_PROBES, REST_SPAN};
 
 use crate::prosody::arith::{Arith, DefaultArith};
 use crate::prosody::{Event, FrontEnd, ProsodyConfig};

@@ -3,7 +3,7 @@
 //! shown, so the controller and the whole-file plan (`gesture-trainer`'s bake) begin their
 //! rests alike.
 
-use crate::player::LibraryFrames;
+use crate::player::{LibraryFrames, Player};
 use crate::rotation::wrap_deg;
 
 /// The most frames of a rest segment [`rest_entry`] compares with the pose shown (a longer
@@ -75,4 +75,17 @@ pub fn rest_entry<L: LibraryFrames + ?Sized>(lib: &L, c: usize, pose: &[f32]) ->
         frame,
         span: (lo, hi),
     }
+}
+
+/// Where `player` stands against a rest's `span` (from [`rest_entry`]): at its end while
+/// playing forward (or at the segment's last frame), and at or before its start. A rest turns
+/// at either (the player itself turns at frame 0); the controller and the whole-file plan
+/// both ask here, so they turn on the same ticks.
+pub fn span_ends<L: LibraryFrames + ?Sized>(
+    lib: &L,
+    player: &Player,
+    span: (usize, usize),
+) -> (bool, bool) {
+    let at_end = !player.backward() && (player.at_end(lib) || player.frame() >= span.1);
+    (at_end, player.position() <= span.0 as f32)
 }

@@ -2,7 +2,7 @@
 //! `crate::follow`), and handed over to another rest once it has held for long
 //! ([`HOLD_SHARE`]).
 
-use super::rest_entry::rest_entry;
+use super::rest_entry::{rest_entry, span_ends};
 use super::{Controller, ControllerEvent};
 use crate::player::{LibraryFrames, PlayerCommand};
 use crate::policy::{Penalties, PolicyTables};
@@ -21,9 +21,7 @@ impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'
         sink: &mut impl FnMut(ControllerEvent<'_>),
     ) {
         let (lo, hi) = self.rest_span;
-        let at_end = !self.player.backward()
-            && (self.player.at_end(self.lib) || self.player.frame() >= hi as usize);
-        let at_start = self.player.position() <= lo as f32;
+        let (at_end, at_start) = span_ends(self.lib, &self.player, (lo as usize, hi as usize));
         let turning = at_end || at_start;
         if let Some(c) = turning
             .then(|| self.rest_hand_over(segment, tick))

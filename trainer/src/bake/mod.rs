@@ -25,7 +25,7 @@ pub mod variety;
 pub use error::BakeError;
 
 use gesture_runtime::blob::Blob;
-use gesture_runtime::controller::rest_entry;
+use gesture_runtime::controller::{rest_entry, span_ends};
 use gesture_runtime::follow::{rest_rate, rest_segments, RestSet};
 use gesture_runtime::player::{
     library_speed_cap, within_limits, LibraryFrames, Player, PlayerCommand, MAX_CHANNELS,
@@ -173,10 +173,8 @@ fn commands(
         }
         player.tick(blob, &mut pose);
         // A rest plays to and fro among its calm frames (`rest_entry`), as the controller's.
-        let (lo, hi) = span;
-        let at_end = !player.backward() && (player.at_end(blob) || player.frame() >= hi);
-        let at_start = player.backward() && player.position() <= lo as f32;
-        if k + 1 < rest_until && (at_end || at_start) {
+        let (at_end, at_start) = span_ends(blob, &player, span);
+        if k + 1 < rest_until && (at_end || (at_start && player.backward())) {
             out.push((k + 1, PlayerCommand::Turn));
         }
         while next < plan.len() && plan[next].tick <= k {
