@@ -48,7 +48,7 @@
 //!   segments of the shared 067 take move at 0.4 of its median hand speed) would still gesture
 //!   in the pauses. While resting, a segment faster than [`REST_SPEED`] of the library's median
 //!   plays slower in proportion ([`rest_rate`]), at least at half its pace
-//!   ([`MIN_RATE`](crate::player::MIN_RATE)), interpolated between frames: a calm motion at
+//!   ([`REST_MIN_RATE`]), interpolated between frames: a calm motion at
 //!   half speed reads as breathing and drift, not as slow motion.
 //! - **a tone** the user chose (`policy::Style`) sets the body's energy while speaking: the
 //!   speaking energy weight is scaled by the style's neutral weight plus the weights of the
@@ -152,13 +152,16 @@ pub const EXPRESSION: Expressive = Expressive {
 /// energy `ln(REST_SPEED)` or less plays at its own pace while resting).
 pub const REST_SPEED: f32 = 0.2;
 
+/// The slowest pace of a rest: half the library's. Calm motion at half speed still reads as
+/// breathing and drift; slower, it reads as slow motion.
+pub const REST_MIN_RATE: f32 = 0.5;
+
 /// The playback rate of a segment of energy `energy` while resting: its own pace if it is
-/// calm enough ([`REST_SPEED`]), else slower in proportion, down to the player's
-/// [`MIN_RATE`](crate::player::MIN_RATE).
+/// calm enough ([`REST_SPEED`]), else slower in proportion, down to [`REST_MIN_RATE`].
 pub fn rest_rate(energy: f32) -> f32 {
     let r = REST_SPEED * libm::expf(-energy);
     if r.is_finite() {
-        r.clamp(crate::player::MIN_RATE, 1.0)
+        r.clamp(REST_MIN_RATE, 1.0)
     } else {
         1.0
     }
@@ -622,7 +625,7 @@ mod tests {
         assert_eq!(rest_rate(REST_SPEED.ln()), 1.0);
         let r = rest_rate(REST_SPEED.ln() + 0.5);
         assert!((r - (-0.5f32).exp()).abs() < 1e-6, "{r}");
-        assert_eq!(rest_rate(2.0), crate::player::MIN_RATE);
+        assert_eq!(rest_rate(2.0), REST_MIN_RATE);
         assert_eq!(rest_rate(f32::NAN), 1.0);
     }
 

@@ -20,12 +20,15 @@
 //!   prepare as a speaker's do, just before the first syllable.
 //! - **Strokes land on syllables.** When the playing segment's next stroke (`library.peaks`)
 //!   lies within the look-ahead, the syllable onset nearest to where it would fall (within
-//!   `stroke_shift_ms`) becomes its target, and the approach to the stroke is played at the
-//!   rate that brings the stroke there: `rate = (stroke - position) / (target - now)`,
-//!   recomputed every tick and kept within the player's `MIN_RATE..=MAX_RATE`. A speaker does
-//!   the same (the preparation stretches or a pre-stroke hold waits, so the stroke meets the
-//!   stressed syllable: McNeill's phonological synchrony rule); the shift is at most a few
-//!   frames, spread over the approach.
+//!   `stroke_shift_ms`) becomes its target, and the preparation is played at the rate that
+//!   brings the stroke there, the stroke itself at the library's pace: the last
+//!   [`STROKE_PACE_MS`] before the stroke's frame take their own time and the frames before
+//!   them take the rest, `rate = (ahead - k) / (ticks - k)` with `ahead` the frames to the
+//!   stroke, `ticks` the ticks to the target and `k` the stroke's own frames, recomputed
+//!   every tick, within [`WARP_MIN`]..=[`WARP_MAX`]. A speaker does the same: the
+//!   preparation stretches or shortens, or a pre-stroke hold waits, so the stroke meets the
+//!   stressed syllable (McNeill's phonological synchrony rule), and the stroke keeps its
+//!   speed.
 //!
 //! The belief steps as soon as a step is reported (the choice of segment uses what is known of
 //! the coming speech). With `ms = 0` nothing is delayed and everything happens exactly as in
@@ -45,16 +48,29 @@ pub const PENDING: usize = 24;
 /// Syllable onsets known ahead of the played time.
 pub const ONSETS: usize = 16;
 
-/// The slowest and fastest pace of a stroke's approach: a stroke is moved to an onset only if
-/// a steady rate within these brings it there.
-pub const WARP_MIN: f32 = 0.6;
-/// See [`WARP_MIN`].
+/// The slowest pace of a stroke's preparation: a stroke is moved to an onset only if a steady
+/// rate within [`WARP_MIN`]..=[`WARP_MAX`], before the stroke's own [`STROKE_PACE_MS`],
+/// brings it there. The preparation is where a speaker's timing gives: it stretches, down to
+/// a pre-stroke hold, so that the stroke meets its syllable (McNeill). On
+/// the 001 take with the 067 library at 500 ms look-ahead (30 runs) the beat lift was +0.099
+/// with 0.6-1.5 and +0.134 with 0.3-1.5, against the capture's +0.128; where the hands hold
+/// through a syllable before a stroke it costs coupling (the 9-joint tuning span: +0.614 to
+/// +0.534, the capture's +0.545; docs/method.md).
+pub const WARP_MIN: f32 = 0.3;
+/// The fastest pace of a stroke's preparation. A preparation hurried to 2x lifted the beat
+/// lift further (+0.140 on that span) but moved the hands faster than the capture ever did:
+/// on 067's last ten seconds the 99th percentile of the hands' step per frame rose from 8.2
+/// to 10.9 against the capture's 7.6; at 1.5 it is 7.8.
 pub const WARP_MAX: f32 = 1.5;
 
+/// How long before its frame a stroke plays at the library's pace (ms): the stroke's rise
+/// keeps its own speed, and only the preparation before it is stretched or hurried.
+pub const STROKE_PACE_MS: u32 = 200;
+
 /// How fast the stroke's playback rate changes (rate units per second): an abrupt change of
-/// pace is a kick in the hands' acceleration; at this slew a change of a third takes a fifth
-/// of a second.
-pub const RATE_SLEW_PER_S: f32 = 2.0;
+/// pace is a kick in the hands' acceleration; at this slew the preparation's pace is back at
+/// the library's within a few ticks of the stroke's own [`STROKE_PACE_MS`].
+pub const RATE_SLEW_PER_S: f32 = 6.0;
 
 /// How the controller uses audio it hears before it is played.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -136,6 +152,8 @@ pub(super) struct Ahead {
     horizon: usize,
     /// Frames ahead a stroke is looked for: the look-ahead and the shift.
     reach: usize,
+    /// Frames before a stroke played at the library's pace ([`STROKE_PACE_MS`]).
+    stroke_pace: f32,
     pending: Deque<(u64, VoiceItem), PENDING>,
     onsets: Deque<u64, ONSETS>,
     aim: Option<Aim>,
@@ -166,6 +184,7 @@ impl Ahead {
             shift: 0,
             horizon: 0,
             reach: 0,
+            stroke_pace: 0.0,
             pending: Deque::new(),
             onsets: Deque::new(),
             aim: None,
@@ -201,6 +220,7 @@ impl Ahead {
         // front-end's report delay (about 0.1 s).
         self.horizon = ms_ticks(l.ms.saturating_sub(100), fps_milli) as usize;
         self.reach = ms_ticks(l.ms.saturating_add(l.stroke_shift_ms), fps_milli) as usize;
+        self.stroke_pace = ms_ticks(STROKE_PACE_MS, fps_milli) as f32;
         self.aim = None;
         self.rate = 1.0;
         self.slew = RATE_SLEW_PER_S * 1000.0 / fps_milli.max(1) as f32;
@@ -333,7 +353,7 @@ impl Ahead {
                 continue;
             }
             let d = (t as f32 - aim.natural).abs();
-            let rate = ahead / (t - now) as f32;
+            let rate = self.approach_rate(ahead, (t - now) as f32);
             if d <= self.shift as f32
                 && (WARP_MIN..=WARP_MAX).contains(&rate)
                 && best.is_none_or(|(_, bd)| d < bd)
@@ -350,8 +370,22 @@ impl Ahead {
         self.aim = Some(aim);
         // Closed loop: the rate that brings the stroke to its tick from where playback stands.
         match aim.at {
-            Some(at) => (ahead / (at - now) as f32).clamp(MIN_RATE, MAX_RATE),
+            Some(at) => self
+                .approach_rate(ahead, (at - now) as f32)
+                .clamp(MIN_RATE, MAX_RATE),
             None => 1.0,
+        }
+    }
+
+    /// The pace that shows a stroke `ahead` frames on in `ticks` ticks, its last
+    /// [`STROKE_PACE_MS`] at the library's pace: `(ahead - k) / (ticks - k)`, or
+    /// `ahead / ticks` once the stroke is nearer than that (or due sooner).
+    fn approach_rate(&self, ahead: f32, ticks: f32) -> f32 {
+        let k = self.stroke_pace;
+        if ahead > k && ticks > k {
+            (ahead - k) / (ticks - k)
+        } else {
+            ahead / ticks
         }
     }
 
@@ -488,5 +522,68 @@ mod tests {
         // (tick 48).
         let second = second.unwrap_or(u64::MAX);
         assert!(second.abs_diff(51) <= 1, "{second}");
+    }
+
+    /// The rates `ahead` gives while [`STROKE`] plays from tick 0, up to the tick its frame is
+    /// reached (inclusive), and that tick.
+    fn stroke_rates(ahead: &mut Ahead) -> (heapless::Vec<f32, 100>, u64) {
+        let mut player = Player::new();
+        let mut out = [0.0; crate::player::MAX_CHANNELS];
+        let mut rates = heapless::Vec::new();
+        for now in 0..100u64 {
+            let r = ahead.stroke_rate(&STROKE, &player, now);
+            let _ = rates.push(r);
+            player.set_rate(r);
+            player.tick(&STROKE, &mut out);
+            if out[0] >= 40.0 - 1e-3 {
+                return (rates, now);
+            }
+        }
+        (rates, u64::MAX)
+    }
+
+    #[test]
+    fn the_preparation_waits_or_hurries_and_the_stroke_keeps_its_pace() {
+        const FPS_MILLI: u64 = 30_000;
+        // The stroke's own 200 ms are 6 ticks at 30 fps.
+        let k = 6;
+        for (onset_frame, tick) in [(160u32, 48u64), (117, 35)] {
+            // An onset 8 ticks after the stroke's own time (tick 48, 267 ms) or 5 before
+            // (tick 35): the preparation plays at about 34/42 = 0.81x or 34/29 = 1.17x once
+            // the onset is known, and the stroke's last six frames at the library's pace (one steady
+            // pace would play them at 40/48 = 0.83x or 40/35 = 1.14x).
+            let mut ahead = Ahead::new();
+            ahead.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
+            ahead.onset(onset_frame, 0, FPS_MILLI);
+            let (rates, t) = stroke_rates(&mut ahead);
+            assert!(t.abs_diff(tick) <= 1, "stroke at {t}, onset at {tick}");
+            let stroke = &rates[rates.len() - k..];
+            assert!(
+                stroke.iter().all(|r| (r - 1.0).abs() <= 0.05),
+                "the stroke's own frames at {stroke:?}"
+            );
+            let early = rates[5];
+            let want = if tick > 40 { 34.0 / 42.0 } else { 34.0 / 29.0 };
+            assert!(
+                (early - want).abs() < 0.05,
+                "preparation at {early}, not {want}"
+            );
+        }
+        // A longer wait (a shift of 1000 ms allowed): an onset 30 ticks late (tick 70). The
+        // preparation plays its 34 frames in 64 ticks, 0.53x, where one steady pace over the
+        // whole approach would have been 40/70 = 0.57x.
+        let mut slow = Ahead::new();
+        slow.set(
+            Lookahead {
+                stroke_shift_ms: 1000,
+                ..Lookahead::ms(1000)
+            },
+            16_000,
+            FPS_MILLI,
+        );
+        slow.onset(233, 0, FPS_MILLI);
+        let (rates, t) = stroke_rates(&mut slow);
+        assert!(t.abs_diff(70) <= 1, "stroke at {t}");
+        assert!(rates[10] < 0.6, "{}", rates[10]);
     }
 }

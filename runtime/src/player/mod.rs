@@ -101,12 +101,14 @@ pub const REST_BLEND: f32 = 0.05;
 /// (10 s at the default 400 ms).
 pub const REST_STRETCH: u32 = 25;
 
-/// The slowest playback rate (frames per tick): half the library's pace. Calm motion at half
-/// speed still reads as breathing and drift; slower, it reads as slow motion.
-pub const MIN_RATE: f32 = 0.5;
+/// The slowest playback rate (frames per tick): 0.3 of the library's pace, reached only on a
+/// stroke's preparation when look-ahead lands it on a syllable (the preparation waits, as a
+/// speaker's pre-stroke hold does; `controller::WARP_MIN`). Everything else plays at half
+/// the pace or more ([`crate::follow::rest_rate`]).
+pub const MIN_RATE: f32 = 0.3;
 
 /// The fastest playback rate (frames per tick): half again the library's pace, reached only
-/// on a stroke's approach when look-ahead lands it on a syllable.
+/// on a stroke's preparation when look-ahead lands it on a syllable (`controller::WARP_MAX`).
 pub const MAX_RATE: f32 = 1.5;
 
 /// A phase this close to a whole frame counts as one (so a rate of 1 never interpolates).

@@ -74,7 +74,7 @@ pub enum ShowError {
         /// The kind (0..=7).
         kind: u8,
     },
-    /// A rate is not finite or outside the player's 0.5..=1.5.
+    /// A rate is not finite or outside the player's 0.3..=1.5.
     BadRate {
         /// Index of the record.
         command: u32,
@@ -222,7 +222,7 @@ impl fmt::Display for ShowError {
                 write!(f, "command {command}: unknown kind {kind}")
             }
             Self::BadRate { command } => {
-                write!(f, "command {command}: rate not finite or outside 0.5..=1.5")
+                write!(f, "command {command}: rate not finite or outside 0.3..=1.5")
             }
             Self::BadGain { command } => {
                 write!(f, "command {command}: gain not finite or outside 0..=2")
