@@ -47,11 +47,12 @@
 //! after it (its recorded successor) without a cut, so the body keeps moving while the
 //! controller waits for a syllable onset.
 //!
-//! **Playback rate.** [`Player::set_rate`] slows playback down to [`MIN_RATE`] (half the
+//! **Playback rate.** [`Player::set_rate`] slows playback down to [`MIN_RATE`] (0.3 of the
 //! library's pace) or speeds it up to [`MAX_RATE`], interpolating between frames: the
 //! controller plays a calm segment slower while the character rests if the segment moves
-//! faster than a rest should ([`crate::follow::rest_rate`]), and with look-ahead it stretches
-//! or hurries a stroke's approach so the stroke lands on a coming syllable.
+//! faster than a rest should ([`crate::follow::rest_rate`], at least half the pace), and with
+//! look-ahead it stretches or hurries a stroke's preparation so the stroke lands on a coming
+//! syllable (the stroke itself at the library's pace).
 //!
 //! **Expression.** After the blend, [`Player::set_gain`] scales the quick part of the frames'
 //! motion around its slow part (the posture), eased in, and leaves a cut's blend as it is
