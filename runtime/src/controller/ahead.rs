@@ -53,9 +53,9 @@ pub const ONSETS: usize = 16;
 /// brings it there. The preparation is where a speaker's timing gives: it stretches, down to
 /// a pre-stroke hold, so that the stroke meets its syllable (McNeill). On
 /// the 001 take with the 067 library at 500 ms look-ahead (30 runs) the beat lift was +0.099
-/// with 0.6-1.5 and +0.134 with 0.3-1.5, against the capture's +0.128; where the hands hold
-/// through a syllable before a stroke it costs coupling (the 9-joint tuning span: +0.614 to
-/// +0.534, the capture's +0.545; docs/method.md).
+/// with 0.6-1.5 and +0.134 with 0.3-1.5, against the capture's +0.128. It costs coupling on
+/// some speech (the 9-joint tuning span: +0.614 to +0.534, the capture's +0.545;
+/// docs/method.md).
 pub const WARP_MIN: f32 = 0.3;
 /// The fastest pace of a stroke's preparation. A preparation hurried to 2x lifted the beat
 /// lift further (+0.140 on that span) but moved the hands faster than the capture ever did:
