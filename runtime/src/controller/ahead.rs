@@ -51,11 +51,10 @@ pub const ONSETS: usize = 16;
 /// The slowest pace of a stroke's preparation: a stroke is moved to an onset only if a steady
 /// rate within [`WARP_MIN`]..=[`WARP_MAX`], before the stroke's own [`STROKE_PACE_MS`],
 /// brings it there. The preparation is where a speaker's timing gives: it stretches, down to
-/// a pre-stroke hold, so that the stroke meets its syllable (McNeill). On
-/// the 001 take with the 067 library at 500 ms look-ahead (30 runs) the beat lift was +0.099
-/// with 0.6-1.5 and +0.134 with 0.3-1.5, against the capture's +0.128. It costs coupling on
-/// some speech (the 9-joint tuning span: +0.614 to +0.534, the capture's +0.545;
-/// docs/method.md).
+/// a pre-stroke hold, so that the stroke meets its syllable (McNeill). On the 001 take with
+/// the 067 library at 500 ms look-ahead (30 runs) the beat lift was +0.099 with 0.6-1.5 and
+/// +0.134 with 0.3-1.5, against the capture's +0.128. It costs coupling on some speech (the
+/// 9-joint tuning span: +0.614 to +0.534, the capture's +0.545; docs/method.md).
 pub const WARP_MIN: f32 = 0.3;
 /// The fastest pace of a stroke's preparation. A preparation hurried to 2x lifted the beat
 /// lift further (+0.140 on that span) but moved the hands faster than the capture ever did:
@@ -546,12 +545,13 @@ mod tests {
     fn the_preparation_waits_or_hurries_and_the_stroke_keeps_its_pace() {
         const FPS_MILLI: u64 = 30_000;
         // The stroke's own 200 ms are 6 ticks at 30 fps.
-        let k = 6;
+        let k = ms_ticks(STROKE_PACE_MS, FPS_MILLI) as usize;
+        assert_eq!(k, 6);
         for (onset_frame, tick) in [(160u32, 48u64), (117, 35)] {
             // An onset 8 ticks after the stroke's own time (tick 48, 267 ms) or 5 before
             // (tick 35): the preparation plays at about 34/42 = 0.81x or 34/29 = 1.17x once
-            // the onset is known, and the stroke's last six frames at the library's pace (one steady
-            // pace would play them at 40/48 = 0.83x or 40/35 = 1.14x).
+            // the onset is known, and the stroke's last six frames at the library's pace (one
+            // steady pace would play them at 40/48 = 0.83x or 40/35 = 1.14x).
             let mut ahead = Ahead::new();
             ahead.set(Lookahead::ms(1000), 16_000, FPS_MILLI);
             ahead.onset(onset_frame, 0, FPS_MILLI);
