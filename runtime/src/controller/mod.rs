@@ -703,7 +703,7 @@ impl<'a, T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controll
     ) {
         let now = tick.min(u32::MAX as u64) as u32;
         let mut penalties = Penalties::new(
-            &self.variety,
+            &self.variety.under_style(self.voice_share),
             &self.history,
             now,
             self.ms_ticks(self.variety.recency_ms),

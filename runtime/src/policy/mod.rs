@@ -19,10 +19,16 @@
 //!   played in the last `usage` window (no segment should dominate the minute).
 //!
 //! Both are added to the candidates' costs. Continuing the current segment at an interruption
-//! exit is charged its usage only (playing on is not a repeat, but a long segment that plays
-//! on at every interruption exit is what comes to dominate the minute: on the 9-joint
-//! ZeroEGGS library a 9-second segment took a third of 50 s of new speech); the value tables
-//! are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
+//! exit is charged a quarter of its usage ([`CONTINUE_USAGE_SHARE`]) and no recency: playing
+//! on is not a repeat, but a long segment that plays on at every interruption exit is what
+//! comes to dominate the minute (on the 9-joint ZeroEGGS library a 9-second segment took a
+//! third of 50 s of new speech). Only a quarter, because leaving a segment that has played
+//! long is a cut in the middle of its motion, which waits for a pause of its hands that
+//! may be far from calm: charged in full, a usage cost high enough to spread the entries
+//! over half the library also raised the hands' speed at cuts above random choices'. Under a
+//! style that leans calm the usage cost falls to half ([`Variety::under_style`]): a calm tone
+//! asks for fewer segments, and spreading it over the library took its effect away. The
+//! value tables are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
 //! cost of variety against the pure policy (its regret) is measured by
 //! `gesture-train eval-motion`. All arithmetic is on integer ticks and the same `f32`
 //! operations on host and device, so both choose alike.
@@ -97,6 +103,23 @@ pub struct Variety {
 }
 
 impl Variety {
+    /// These costs under a style whose voice share is `share` ([`crate::follow::voice_share`]:
+    /// 1 for the neutral style and tones that lean energetic, 0 for calm ones): the usage cost
+    /// scaled by `TONE_USAGE_FLOOR + (1 - TONE_USAGE_FLOOR) * share`. A calm tone favours
+    /// fewer segments; the full usage cost spread it back over the library and took away a
+    /// third of its effect (see the module docs).
+    pub fn under_style(&self, share: f32) -> Self {
+        let share = if share.is_finite() {
+            share.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        Self {
+            usage_cost: self.usage_cost * (TONE_USAGE_FLOOR + (1.0 - TONE_USAGE_FLOOR) * share),
+            ..*self
+        }
+    }
+
     /// No variety costs: the pure policy.
     pub const NONE: Self = Self {
         recency_cost: 0.0,
@@ -105,6 +128,9 @@ impl Variety {
         usage_ms: 0,
     };
 }
+
+/// The share of the usage cost a style of calm tones keeps ([`Variety::under_style`]).
+pub const TONE_USAGE_FLOOR: f32 = 0.5;
 
 /// Segment entries the controller remembers.
 pub const HISTORY: usize = 32;
@@ -265,15 +291,26 @@ impl Penalties {
         self.slot(c).map_or(0.0, |k| self.cost[k])
     }
 
-    /// The usage part of the penalty of segment `c` (what continuing it is charged).
+    /// The usage part of the penalty of segment `c`.
     pub fn usage_of(&self, c: usize) -> f32 {
         self.slot(c).map_or(0.0, |k| self.usage[k])
     }
+
+    /// What continuing (or holding) segment `c` is charged: [`CONTINUE_USAGE_SHARE`] of its
+    /// usage (see the module docs).
+    pub fn continuing(&self, c: usize) -> f32 {
+        CONTINUE_USAGE_SHARE * self.usage_of(c)
+    }
 }
 
+/// The share of a segment's usage cost that continuing it pays (see the module docs): with
+/// the default usage cost of 48, continuing pays 12, what it paid before entries were charged
+/// more.
+pub const CONTINUE_USAGE_SHARE: f32 = 0.25;
+
 /// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries), each
-/// candidate segment `c` charged `penalty.of(c)` on top and continuing charged the usage of
-/// the exit's segment, `penalty.usage_of(..)`. At an end exit with no successor (a
+/// candidate segment `c` charged `penalty.of(c)` on top and continuing charged
+/// `penalty.continuing(..)` of the exit's segment. At an end exit with no successor (a
 /// blob whose pruning left none) the choice falls back to entering segment 0, so playback
 /// never stalls.
 pub fn select<T: PolicyTables + ?Sized>(
@@ -303,7 +340,7 @@ pub fn select_styled<T: PolicyTables + ?Sized>(
     };
     if !t.exit_is_end(e) {
         let a = t.exit_segment(e);
-        best.cost = style.u_cont_dot(t, e, b) + penalty.usage_of(a) + penalty.voice(t, a);
+        best.cost = style.u_cont_dot(t, e, b) + penalty.continuing(a) + penalty.voice(t, a);
         best.candidates = 1;
     }
     let mut worst_junction = 0.0f32;
@@ -365,7 +402,7 @@ pub fn select_labelled<T: PolicyTables + ?Sized>(
     };
     if !t.exit_is_end(e) {
         let a = t.exit_segment(e);
-        best.cost = t.label_u_cont_dot(w, e, b) + penalty.usage_of(a) + other(a);
+        best.cost = t.label_u_cont_dot(w, e, b) + penalty.continuing(a) + other(a);
         best.candidates = 1;
     }
     for k in 0..t.successor_count(e) {
@@ -429,6 +466,22 @@ mod tests {
         let p = Penalties::new(&v, &h, 100, 0, 30);
         assert!((p.of(3) - 10.0 * 20.0 / 30.0).abs() < 1e-5);
         assert!((p.of(5) - 10.0 * 10.0 / 30.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn a_calm_style_keeps_half_the_usage_cost() {
+        let v = Variety {
+            recency_cost: 2.0,
+            recency_ms: 8000,
+            usage_cost: 24.0,
+            usage_ms: 45000,
+        };
+        assert_eq!(v.under_style(1.0), v);
+        assert_eq!(v.under_style(f32::NAN), v);
+        let calm = v.under_style(0.0);
+        assert_eq!((calm.usage_cost, calm.recency_cost), (12.0, 2.0));
+        assert_eq!(v.under_style(0.5).usage_cost, 18.0);
+        assert_eq!(v.under_style(-3.0).usage_cost, 12.0);
     }
 
     #[test]
@@ -526,24 +579,33 @@ mod tests {
         }
     }
 
-    /// Continuing is charged the playing segment's usage, not its recency: just entered, it
-    /// plays on; after dominating the usage window it gives way.
+    /// Continuing is charged a quarter of the playing segment's usage, not its recency: just
+    /// entered, it plays on; after dominating the usage window it gives way, later than an
+    /// entry of it would.
     #[test]
-    fn continuing_pays_usage_but_not_recency() {
-        let v = Variety {
+    fn continuing_pays_a_quarter_of_the_usage_but_no_recency() {
+        let v = |usage_cost| Variety {
             recency_cost: 5.0,
             recency_ms: 0,
-            usage_cost: 1.0,
+            usage_cost,
             usage_ms: 0,
         };
-        // Entered 5 ticks ago: recency 5 * 0.95, usage 1 * 5/100.
-        let p = Penalties::new(&v, &history(&[(0, 95)]), 100, 100, 100);
-        assert!((p.usage_of(0) - 0.05).abs() < 1e-6);
+        // Entered 5 ticks ago: recency 5 * 0.95, usage 4 * 5/100, continuing a quarter of it.
+        let p = Penalties::new(&v(4.0), &history(&[(0, 95)]), 100, 100, 100);
+        assert!((p.usage_of(0) - 0.2).abs() < 1e-6);
+        assert!((p.continuing(0) - 0.05).abs() < 1e-6);
         let d = select(&Playing, 0, &[1.0], &p);
         assert_eq!(d.choice, Choice::Continue);
         assert!((d.cost - 1.05).abs() < 1e-6, "{}", d.cost);
-        // Playing for the whole 100-tick window: continuing costs 1 + 1 > 1.5.
-        let p = Penalties::new(&v, &history(&[(0, 0)]), 100, 100, 100);
+        // Playing for the whole 100-tick window at a usage cost of 4: continuing costs
+        // 1 + 4 / 4 = 2 > 1.5.
+        let p = Penalties::new(&v(4.0), &history(&[(0, 0)]), 100, 100, 100);
         assert_eq!(select(&Playing, 0, &[1.0], &p).choice, Choice::Enter(1));
+        // At 1.6 it costs 1 + 0.4 = 1.4 < 1.5 and plays on (charged the whole usage, 2.6, it
+        // would have left).
+        let p = Penalties::new(&v(1.6), &history(&[(0, 0)]), 100, 100, 100);
+        let d = select(&Playing, 0, &[1.0], &p);
+        assert_eq!(d.choice, Choice::Continue);
+        assert!((d.cost - 1.4).abs() < 1e-6, "{}", d.cost);
     }
 }

@@ -379,7 +379,7 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
             if s < exits && !blob.exit_is_end(e) && !early_here {
                 cand.push((
                     Act::Continue { rate: 1.0 },
-                    blob.u_cont_dot(e, b) + pen.usage_of(playing),
+                    blob.u_cont_dot(e, b) + pen.continuing(playing),
                     e,
                 ));
             }
@@ -428,7 +428,7 @@ pub fn plan(blob: &Blob<'_>, tl: &Timeline, w: &Weights, prices: &[f32]) -> (Vec
                 for &r in &extras {
                     if s >= exits && r == playing {
                         // Holding on costs what continuing does.
-                        cand.push((Act::Hold, blob.u_dot(r, b) + pen.usage_of(r), e));
+                        cand.push((Act::Hold, blob.u_dot(r, b) + pen.continuing(r), e));
                     } else {
                         cand.push((
                             Act::Rest { segment: r },

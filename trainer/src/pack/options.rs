@@ -18,10 +18,13 @@ use crate::motion::EffectorSpec;
 /// the speech the README reports (docs/method.md, "Variety"). A usage window of a minute
 /// (bounded by the 32 remembered entries) spreads the motion over the library in the
 /// proportions the capture has; a shorter one let a few segments come back every half minute.
+/// The usage cost went from 12 to 24 once continuing paid only a quarter of it
+/// (`gesture_runtime::policy::CONTINUE_USAGE_SHARE`): more of the library is entered without
+/// leaving segments in the middle of their motion; 48 took a third of the tones' effect away.
 pub const DEFAULT_VARIETY: Variety = Variety {
     recency_cost: 1.0,
     recency_ms: 8000,
-    usage_cost: 12.0,
+    usage_cost: 24.0,
     usage_ms: 45000,
 };
 
