@@ -304,8 +304,7 @@ impl Penalties {
 }
 
 /// The share of a segment's usage cost that continuing it pays (see the module docs): with
-/// the default usage cost of 48, continuing pays 12, what it paid before entries were charged
-/// more.
+/// the default usage cost of 24 it pays 6 (12 when it paid the whole of a usage cost of 12).
 pub const CONTINUE_USAGE_SHARE: f32 = 0.25;
 
 /// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries), each
