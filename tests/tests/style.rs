@@ -112,11 +112,11 @@ fn bandai_tones_restyle_a_zeroeggs_library_on_new_speech() {
     // Means of 30 delayed runs (a single run's ratio moved by 0.2 between settings): active
     // x1.06, sad x0.65, the mix x0.99, energetic x1.04, calm x0.86 with the default timing,
     // the voice followed and the default variety (before the voice: x1.11, x0.50, x0.85,
-    // x1.07, x0.91). The neutral
-    // style follows the voice's energy (loud syllables bring energetic segments, and no rest
-    // is shown while speaking), which is much of what an active tone adds: the tones still
-    // order the motion, but active and energetic add little over the voice. (With the voice's
-    // energy term on the neutral share alone, energetic was x0.95: slower than neutral.)
+    // x1.07, x0.91). The neutral style follows the voice's energy (loud syllables bring
+    // energetic segments, and no rest is shown while speaking), which is much of what an
+    // active tone adds: the tones still order the motion, but active and energetic add little
+    // over the voice. (With the voice's energy term on the neutral share alone, energetic was
+    // x0.95: slower than neutral.)
     assert!(active > 1.0, "active x{active}");
     assert!(sad <= 0.87, "sad x{sad}");
     assert!(
