@@ -21,10 +21,10 @@
 //! - **Strokes land on syllables.** When the playing segment's next stroke (`library.peaks`)
 //!   lies within the look-ahead, the syllable onset nearest to where it would fall (within
 //!   [`NEAR_SHIFT_MS`]; within `stroke_shift_ms` for a stroke that waits, below) becomes its
-//!   target, and the preparation is played at the rate that
-//!   brings the stroke there, the stroke itself at the library's pace: the last
-//!   [`STROKE_PACE_MS`] before the stroke's frame take their own time and the frames before
-//!   them take the rest, `rate = (ahead - k) / (ticks - k)` with `ahead` the frames to the
+//!   target, and the preparation is played at the rate that brings the stroke there, the
+//!   stroke itself at the library's pace: the last [`STROKE_PACE_MS`] before the stroke's
+//!   frame take their own time and the frames before them take the rest,
+//!   `rate = (ahead - k) / (ticks - k)` with `ahead` the frames to the
 //!   stroke, `ticks` the ticks to the target and `k` the stroke's own frames, recomputed
 //!   every tick, within [`WARP_MIN`]..=[`WARP_MAX`]. A speaker does the same: the
 //!   preparation stretches or shortens, or a pre-stroke hold waits, so the stroke meets the
@@ -37,9 +37,9 @@
 //!   keep the stroke at the edge of what is heard, until a syllable comes in reach (then it is
 //!   aimed at it), and at most until the tick at which all of the speech within the shift
 //!   after the stroke's own time has been heard (with a look-ahead longer than the shift that
-//!   tick comes before the stroke's own, and nothing waits). Without the wait, a stroke in a gap
-//!   between two phrases played in the gap: on the 001 take with the 067 library at 500 ms,
-//!   7 of 104 strokes, 0.2-0.6 s from any syllable.
+//!   tick comes before the stroke's own, and nothing waits). Without the wait, a stroke in a
+//!   gap between two phrases played in the gap: on the 001 take with the 067 library at
+//!   500 ms, 7 of 104 strokes, 0.2-0.6 s from any syllable.
 //!
 //! The belief steps as soon as a step is reported (the choice of segment uses what is known of
 //! the coming speech). With `ms = 0` nothing is delayed and everything happens exactly as in
@@ -123,8 +123,9 @@ impl Lookahead {
     /// a gap of the speech, with no syllable heard near it, may wait for the next one, a
     /// pre-stroke hold; any other stroke is moved at most [`NEAR_SHIFT_MS`], 300 ms, the gap
     /// between two syllables at 3-4 per second, so nearly every stroke finds one: 200 ms left
-    /// more strokes off the syllables on tuning speech) and decision lead (100 ms: on tuning speech the hands' speed followed the
-    /// voice best there, among 0, 50, 100, 150 and 200 ms; docs/method.md).
+    /// more strokes off the syllables on tuning speech) and decision lead (100 ms: on tuning
+    /// speech the hands' speed followed the voice best there, among 0, 50, 100, 150 and
+    /// 200 ms; docs/method.md).
     pub const fn ms(ms: u32) -> Self {
         let ms = if ms > MAX_LOOKAHEAD_MS {
             MAX_LOOKAHEAD_MS
@@ -678,9 +679,9 @@ mod tests {
         assert!(rates.iter().any(|&r| r < 0.6), "no wait: {rates:?}");
         // A syllable at tick 52 is heard only at tick 40, when the stroke would have been
         // shown at the library's pace (where it stayed before the wait): the waiting stroke
-        // is still to come then, takes it and lands on it.
-        // It is 400 ms after the stroke's own time, beyond the 300 ms a stroke that does not
-        // wait is moved: the preparation that waited slows further, below 0.6x, to meet it.
+        // is still to come then, takes it and lands on it. It is 400 ms after the stroke's
+        // own time, beyond the 300 ms a stroke that does not wait is moved: the preparation
+        // that waited slows further, below 0.6x, to meet it.
         let (t, rates) = heard_late(Some(52));
         assert!(t.abs_diff(52) <= 1, "stroke at {t}");
         assert!(rates.iter().any(|&r| r < 0.6), "{rates:?}");
