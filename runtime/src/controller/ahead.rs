@@ -509,20 +509,33 @@ mod tests {
     /// Strokes at frames 40 and 48 (0.27 s apart).
     const TWO_STROKES: Strokes = Strokes(&[40, 48]);
 
-    /// Plays [`STROKE`] from tick 0 with `ahead` steering the rate; the tick at which the
-    /// stroke frame is first reached.
-    fn stroke_tick(ahead: &mut Ahead) -> u64 {
+    /// Plays [`STROKE`] from tick 0 with `ahead` steering the rate, calling `hear` before each
+    /// tick (to feed onsets as they are heard): the rates given up to the tick at which the
+    /// stroke frame is first reached (inclusive), and that tick.
+    fn play_stroke(
+        ahead: &mut Ahead,
+        mut hear: impl FnMut(&mut Ahead, u64),
+    ) -> (heapless::Vec<f32, 100>, u64) {
         let mut player = Player::new();
         let mut out = [0.0; crate::player::MAX_CHANNELS];
+        let mut rates = heapless::Vec::new();
         for now in 0..100u64 {
+            hear(ahead, now);
             let r = ahead.stroke_rate(&STROKE, &player, now);
+            let _ = rates.push(r);
             player.set_rate(r);
             player.tick(&STROKE, &mut out);
             if out[0] >= 40.0 - 1e-3 {
-                return now;
+                return (rates, now);
             }
         }
-        u64::MAX
+        (rates, u64::MAX)
+    }
+
+    /// The tick at which [`STROKE`]'s frame is first reached ([`play_stroke`], onsets fed
+    /// beforehand).
+    fn stroke_tick(ahead: &mut Ahead) -> u64 {
+        play_stroke(ahead, |_, _| {}).1
     }
 
     #[test]
@@ -592,22 +605,10 @@ mod tests {
         assert!(second.abs_diff(51) <= 1, "{second}");
     }
 
-    /// The rates `ahead` gives while [`STROKE`] plays from tick 0, up to the tick its frame is
-    /// reached (inclusive), and that tick.
+    /// The rates `ahead` gives while [`STROKE`] plays ([`play_stroke`], onsets fed
+    /// beforehand), and the tick its frame is reached.
     fn stroke_rates(ahead: &mut Ahead) -> (heapless::Vec<f32, 100>, u64) {
-        let mut player = Player::new();
-        let mut out = [0.0; crate::player::MAX_CHANNELS];
-        let mut rates = heapless::Vec::new();
-        for now in 0..100u64 {
-            let r = ahead.stroke_rate(&STROKE, &player, now);
-            let _ = rates.push(r);
-            player.set_rate(r);
-            player.tick(&STROKE, &mut out);
-            if out[0] >= 40.0 - 1e-3 {
-                return (rates, now);
-            }
-        }
-        (rates, u64::MAX)
+        play_stroke(ahead, |_, _| {})
     }
 
     #[test]
@@ -648,23 +649,13 @@ mod tests {
         let mut ahead = Ahead::new();
         ahead.set(Lookahead::ms(500), 16_000, FPS_MILLI);
         assert_eq!(ahead.horizon, 12);
-        let mut player = Player::new();
-        let mut out = [0.0; crate::player::MAX_CHANNELS];
-        let mut rates = heapless::Vec::new();
-        for now in 0..100u64 {
+        let (rates, t) = play_stroke(&mut ahead, |ahead, now| {
             if let Some(t) = onset.filter(|&t| now + 12 == t) {
                 // The 10 ms frame that starts at tick t.
                 ahead.onset((t * 100_000 / FPS_MILLI) as u32, now, FPS_MILLI);
             }
-            let r = ahead.stroke_rate(&STROKE, &player, now);
-            let _ = rates.push(r);
-            player.set_rate(r);
-            player.tick(&STROKE, &mut out);
-            if out[0] >= 40.0 - 1e-3 {
-                return (now, rates);
-            }
-        }
-        (u64::MAX, rates)
+        });
+        (t, rates)
     }
 
     #[test]
