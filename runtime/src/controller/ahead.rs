@@ -33,7 +33,7 @@
 //! - **A stroke waits for its syllable.** Onsets are known only as far ahead as the audio
 //!   is heard (the look-ahead less the front-end's report delay). When the playing segment's
 //!   next stroke would fall inside that known speech with no onset in reach, it would land in
-//!   a gap of the speech; the preparation slows instead (to no less than [`WAIT_MIN`]) to
+//!   a gap of the speech; the preparation slows instead (to no less than [`WARP_MIN`]) to
 //!   keep the stroke at the edge of what is heard, until a syllable comes in reach (then it is
 //!   aimed at it), and at most until the tick at which all of the speech within the shift
 //!   after the stroke's own time has been heard (with a look-ahead longer than the shift that
@@ -65,22 +65,17 @@ pub const ONSETS: usize = 16;
 /// a pre-stroke hold, so that the stroke meets its syllable (McNeill). On the 001 take with
 /// the 067 library at 500 ms look-ahead (30 runs) the beat lift was +0.099 with 0.6-1.5 and
 /// +0.134 with 0.3-1.5, against the capture's +0.128. It costs coupling on some speech (the
-/// 9-joint tuning span: +0.614 to +0.534, the capture's +0.545; docs/method.md).
+/// 9-joint tuning span: +0.614 to +0.534, the capture's +0.545; docs/method.md). A
+/// preparation that waits for a syllable not yet heard slows as deep: on speech not used
+/// before (the 001 take's first minute with the 067 library, 067's two halves with the 9-joint
+/// library) a floor of 0.5 for the wait left the lift at +0.147 against the capture's +0.166
+/// on the first of them, where this floor gives +0.164 (docs/method.md).
 pub const WARP_MIN: f32 = 0.3;
 /// The fastest pace of a stroke's preparation. A preparation hurried to 2x lifted the beat
 /// lift further (+0.140 on that span) but moved the hands faster than the capture ever did:
 /// on 067's last ten seconds the 99th percentile of the hands' step per frame rose from 8.2
 /// to 10.9 against the capture's 7.6; at 1.5 it is 7.8.
 pub const WARP_MAX: f32 = 1.5;
-
-/// The slowest pace of a preparation that waits for a syllable not yet heard (a pre-stroke
-/// hold, see [`Lookahead::stroke_shift_ms`]). Slower than the library, so that the stroke is
-/// not spent in a gap of the speech, but not held as deep as an aimed stroke may be: the wait
-/// may find no syllable. On the 9-joint tuning span (001 90-121 s, 500 ms look-ahead, 30 runs)
-/// a floor of 0.5 lifted the beat lift from +0.125 to +0.154 and the coupling from +0.546 to
-/// +0.577 (the capture's +0.545), at the same hand speed; [`WARP_MIN`] (0.3) lifted the beat
-/// lift as much but lowered the coupling to +0.519 and the hand speed by a tenth.
-pub const WAIT_MIN: f32 = 0.5;
 
 /// How far (ms) from where it would fall a stroke is moved to a syllable it can reach; a
 /// stroke that waits for a syllable not yet heard takes one up to
@@ -436,7 +431,7 @@ impl Ahead {
         let all_heard = aim.natural + self.shift as f32 - horizon - now as f32;
         let ticks = horizon.min(all_heard);
         if ahead > k && ticks > ahead {
-            self.approach_rate(ahead, ticks).max(WAIT_MIN)
+            self.approach_rate(ahead, ticks).max(WARP_MIN)
         } else {
             1.0
         }
@@ -661,12 +656,12 @@ mod tests {
     #[test]
     fn a_stroke_in_a_gap_of_the_speech_waits_for_the_next_syllable() {
         // No syllable near the stroke (tick 40) in what is heard: the preparation slows at the
-        // edge of what is heard (12 ticks ahead), to no less than WAIT_MIN, and the stroke
+        // edge of what is heard (12 ticks ahead), to no less than WARP_MIN, and the stroke
         // comes no later than tick 46, when the speech up to the shift (600 ms, 18 ticks)
         // after its own time has been heard.
         let (t, rates) = heard_late(None);
         assert!((43..=47).contains(&t), "stroke at {t}");
-        assert!(rates.iter().all(|&r| r >= WAIT_MIN - 1e-3), "{rates:?}");
+        assert!(rates.iter().all(|&r| r >= WARP_MIN - 1e-3), "{rates:?}");
         assert!(rates.iter().any(|&r| r < 0.6), "no wait: {rates:?}");
         // A syllable at tick 52 is heard only at tick 40, when the stroke would have been
         // shown at the library's pace (where it stayed before the wait): the waiting stroke

@@ -81,9 +81,7 @@ use crate::policy::{
 
 pub use crate::policy::{DecisionTiming, MAX_LABELLED, MAX_LABELS};
 use ahead::{Ahead, VoiceItem};
-pub use ahead::{
-    Lookahead, MAX_LOOKAHEAD_MS, NEAR_SHIFT_MS, STROKE_PACE_MS, WAIT_MIN, WARP_MAX, WARP_MIN,
-};
+pub use ahead::{Lookahead, MAX_LOOKAHEAD_MS, NEAR_SHIFT_MS, STROKE_PACE_MS, WARP_MAX, WARP_MIN};
 pub use event::{ControllerError, ControllerEvent, LabelOutcome};
 use labels::Labels;
 pub use labels::{LabelError, LABEL_QUEUE};
