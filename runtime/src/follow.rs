@@ -66,7 +66,10 @@
 //!   first pause step of a silence, so the motion follows the voice within a syllable, not
 //!   only at the next exit point. Resting, a gesture still playing (its cut into a rest waits
 //!   for a pause of its hands, a second or more at the rest's pace) is shown at a quarter of
-//!   its size ([`Expressive::caught`]): it settled sooner on every span measured. Live, the
+//!   its size ([`Expressive::caught`]): it settled sooner on every span measured. A rest
+//!   segment, once it plays in a rest, is shown at its own size: it is the capture's own
+//!   rest (breathing, drift), already calm; at half size a quiet one (the 9-joint take's
+//!   opening) moved under 0.05 degrees a frame, still to the eye and to the freeze measure. Live, the
 //!   loudness is the front-end's 10 ms frames ([`Voice::hear`]: a quick rise, a slower
 //!   fall), not the syllables' levels: a syllable's level is known only once the syllable has
 //!   ended and been confirmed (about 0.09 s later), and the hands' speed then trailed the
@@ -105,12 +108,13 @@ impl VoiceFollow {
 /// How much a gesture's size follows the voice: the player's expression stage
 /// ([`crate::player::expression`]) shows the quick part of the motion `1 + span * v` times its
 /// size while speaking (`v` the loudness heard over [`VOICE_SPAN`], clamped to -1..1; see
-/// [`Voice::gain`]) and `pause` times from the first pause step of a silence.
+/// [`Voice::gain`]) and `pause` times from the first pause step of a silence until a rest
+/// segment plays.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Expressive {
     /// Gain above or below 1 at full voice level (each way).
     pub span: f32,
-    /// Gain in a silence.
+    /// Gain in a silence, until a rest segment plays.
     pub pause: f32,
     /// Gain of a gesture still playing once the character rests (until the cut into a rest
     /// segment, which waits for a pause of the hands).
@@ -363,8 +367,8 @@ impl Voice {
 
     /// The expression gain the voice asks for now ([`Expressive`]), `rest_plays` whether a
     /// rest segment is playing: resting, `e.caught` while a gesture still plays (the cut into
-    /// a rest waits for a pause of its hands), `e.pause` once a rest plays and from the first
-    /// pause step of a silence; else `1 + e.span * min(level / VOICE_SPAN, 1)` down to
+    /// a rest waits for a pause of its hands), 1 once a rest plays (a rest is shown at its own
+    /// size), `e.pause` from the first pause step of a silence; else `1 + e.span * min(level / VOICE_SPAN, 1)` down to
     /// `1 - e.span` at `-VOICE_SPAN`, and from there down to `e.pause` at `-QUIET_SPAN`
     /// ([`QUIET_SPAN`]; `level` the loudness heard, [`Voice::hear`], or without frames the
     /// last syllable's); within the
@@ -374,7 +378,9 @@ impl Voice {
     pub fn gain(&self, e: &Expressive, rest_plays: bool) -> f32 {
         let g = if self.resting && !rest_plays {
             e.caught
-        } else if self.resting || self.silent_steps > 0 {
+        } else if self.resting {
+            1.0
+        } else if self.silent_steps > 0 {
             e.pause
         } else if self.now < -VOICE_SPAN {
             // Quieter still, down to the pause's size at `QUIET_SPAN` under the level.
@@ -511,8 +517,9 @@ mod tests {
         assert_eq!(v.take_change(), Some(VoiceChange::Rest));
         assert_eq!(v.take_change(), None);
         assert_eq!(v.weight(&F), 4.0);
-        // Resting: a gesture still playing shrinks further until a rest segment plays.
-        assert_eq!((v.gain(&e, false), v.gain(&e, true)), (e.caught, e.pause));
+        // Resting: a gesture still playing shrinks further until a rest segment plays, and
+        // the rest plays at its own size.
+        assert_eq!((v.gain(&e, false), v.gain(&e, true)), (e.caught, 1.0));
         assert!(e.caught < e.pause);
         // More silence changes nothing.
         v.step(&F, true, -6.0, 250);

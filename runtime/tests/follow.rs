@@ -397,7 +397,8 @@ fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
         shrink.0
     );
     // Through the silence: resting (from 0.5 s), a quarter while a gesture still plays (its
-    // cut into a rest waits for a pause of the hands), half once a rest segment plays.
+    // cut into a rest waits for a pause of the hands), the rest's own size once a rest
+    // segment plays.
     let silent: Vec<(usize, f32)> = aims
         .iter()
         .copied()
@@ -405,14 +406,14 @@ fn the_gesture_shrinks_in_a_pause_and_grows_back_with_the_speech() {
         .collect();
     for &(i, g) in &silent {
         let want = if rest(ticks[i].segment) {
-            EXPRESSION.pause
+            1.0
         } else {
             EXPRESSION.caught
         };
         assert_eq!(g, want, "gain at tick {i}: {:?}", ticks[i]);
     }
     assert!(rest(ticks[at(6.8)].segment));
-    assert_eq!(silent.last().map_or(shrink.1, |a| a.1), EXPRESSION.pause);
+    assert_eq!(silent.last().map_or(shrink.1, |a| a.1), 1.0);
     // Here the rest caught a gesture: both were aimed.
     assert!(
         silent.iter().any(|a| a.1 == EXPRESSION.caught),
