@@ -69,8 +69,8 @@
 //!   its size ([`Expressive::caught`]): it settled sooner on every span measured. A rest
 //!   segment, once it plays in a rest, is shown at its own size: it is the capture's own
 //!   rest (breathing, drift), already calm; at half size a quiet one (the 9-joint take's
-//!   opening) moved under 0.05 degrees a frame, still to the eye and to the freeze measure. Live, the
-//!   loudness is the front-end's 10 ms frames ([`Voice::hear`]: a quick rise, a slower
+//!   opening) moved under 0.05 degrees a frame, still to the eye and to the freeze measure.
+//!   Live, the loudness is the front-end's 10 ms frames ([`Voice::hear`]: a quick rise, a slower
 //!   fall), not the syllables' levels: a syllable's level is known only once the syllable has
 //!   ended and been confirmed (about 0.09 s later), and the hands' speed then trailed the
 //!   voice by about 0.3 s (their correlation with the loudness was highest with the speech
@@ -368,18 +368,20 @@ impl Voice {
     /// The expression gain the voice asks for now ([`Expressive`]), `rest_plays` whether a
     /// rest segment is playing: resting, `e.caught` while a gesture still plays (the cut into
     /// a rest waits for a pause of its hands), 1 once a rest plays (a rest is shown at its own
-    /// size), `e.pause` from the first pause step of a silence; else `1 + e.span * min(level / VOICE_SPAN, 1)` down to
-    /// `1 - e.span` at `-VOICE_SPAN`, and from there down to `e.pause` at `-QUIET_SPAN`
-    /// ([`QUIET_SPAN`]; `level` the loudness heard, [`Voice::hear`], or without frames the
-    /// last syllable's); within the
-    /// player's [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not finite. Under
+    /// size); not resting, `e.pause` from the first pause step of a silence; else
+    /// `1 + e.span * min(level / VOICE_SPAN, 1)` down to `1 - e.span` at `-VOICE_SPAN`, and
+    /// from there down to `e.pause` at `-QUIET_SPAN` ([`QUIET_SPAN`]; `level` the loudness
+    /// heard, [`Voice::hear`], or without frames the last syllable's); within the player's
+    /// [`GAIN_RANGE`](crate::player::expression::GAIN_RANGE), 1 if not finite. Under
     /// every tone alike: a tone chooses which gestures are played and how energetic they are,
     /// the voice how large they are shown.
     pub fn gain(&self, e: &Expressive, rest_plays: bool) -> f32 {
-        let g = if self.resting && !rest_plays {
-            e.caught
-        } else if self.resting {
-            1.0
+        let g = if self.resting {
+            if rest_plays {
+                1.0
+            } else {
+                e.caught
+            }
         } else if self.silent_steps > 0 {
             e.pause
         } else if self.now < -VOICE_SPAN {
