@@ -9,7 +9,9 @@ pub const REST_SET: usize = 6;
 
 /// The most of the variety costs' usage window (`usage_ms`) one rest may fill while it holds
 /// a pause before it hands over to another ([`RestSet::hand_over`]): the variety line (no
-/// segment over 15 % of a run) less a margin for the blend; 6.3 s of the default 45 s.
+/// segment over 15 % of a run) less a margin for the blend; 6.3 s of the default 45 s. Past
+/// the same share of what a run has played, continuing any segment pays its whole usage
+/// ([`crate::policy::Penalties::continuing`]).
 pub const HOLD_SHARE: f32 = 0.14;
 
 /// The calmest segments of `t` (lowest energy, ties to the lower index), in order of energy:

@@ -19,19 +19,23 @@
 //!   played in the last `usage` window (no segment should dominate the minute).
 //!
 //! Both are added to the candidates' costs. Continuing the current segment at an interruption
-//! exit is charged a quarter of its usage ([`CONTINUE_USAGE_SHARE`]) and no recency: playing
-//! on is not a repeat, but a long segment that plays on at every interruption exit is what
-//! comes to dominate the minute (on the 9-joint ZeroEGGS library a 9-second segment took a
-//! third of 50 s of new speech). Only a quarter, because leaving a segment that has played
-//! long is a cut in the middle of its motion, which waits for a pause of its hands that
-//! may be far from calm: charged in full, a usage cost high enough to spread the entries
-//! over half the library also raised the hands' speed at cuts above random choices'. Under a
-//! style that leans calm the usage cost falls to half ([`Variety::under_style`]): a calm tone
-//! asks for fewer segments, and spreading it over the library took its effect away. The
-//! value tables are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
-//! cost of variety against the pure policy (its regret) is measured by
-//! `gesture-train eval-motion`. All arithmetic is on integer ticks and the same `f32`
-//! operations on host and device, so both choose alike.
+//! exit is charged a quarter of its usage ([`CONTINUE_USAGE_SHARE`]) and no recency: playing on
+//! is not a repeat, but a long segment that plays on at every interruption exit is what comes
+//! to dominate the minute (on the 9-joint ZeroEGGS library a 9-second segment took a third of
+//! 50 s of new speech). Only a quarter, because leaving a segment that has played long is a cut
+//! in the middle of its motion, which waits for a pause of its hands that may be far from calm:
+//! charged in full, a usage cost high enough to spread the entries over half the library also
+//! raised the hands' speed at cuts above random choices'. Once a segment has filled more than
+//! [`HOLD_SHARE`] of what the run has played, though (the variety line, no segment over 15 % of
+//! a run, less a margin), continuing it pays its whole usage, so it gives way before it breaks
+//! the line. A run younger than half the usage window counts as half of it: one gesture of
+//! ordinary length is never over the line, only a segment that comes back or plays on long.
+//! Under a style that leans calm the usage cost falls to half ([`Variety::under_style`]): a
+//! calm tone asks for fewer segments, and spreading it over the library took its effect away.
+//! The value tables are unchanged, so with [`Variety::NONE`] the choice is the paper's. The
+//! cost of variety against the pure policy (its regret) is measured by `gesture-train
+//! eval-motion`. All arithmetic is on integer ticks and the same `f32` operations on host and
+//! device, so both choose alike.
 //!
 //! **Style** (docs/method.md "Style control", the paper's section 8.2). A blob may carry value
 //! tables per tone (`U^m`, `U_cont^m`, solved by the trainer with each tone's transform of the
@@ -56,6 +60,7 @@ pub use style::{Style, StyleError, MAX_TONES};
 pub use tables::{PolicyTables, MAX_LABELLED, MAX_LABELS};
 pub use timing::DecisionTiming;
 
+use crate::rest::HOLD_SHARE;
 use heapless::HistoryBuffer;
 
 /// Most rest segments ([`crate::follow::RestSet`]) a decision adds as candidates while
@@ -154,6 +159,10 @@ pub struct Penalties {
     segment: [u16; HISTORY],
     cost: [f32; HISTORY],
     usage: [f32; HISTORY],
+    /// The usage of a segment that has filled [`HOLD_SHARE`] of what the run has played (its
+    /// age, at least half and at most the whole usage window): continuing a segment with more
+    /// pays its whole usage.
+    line: f32,
     len: usize,
     /// Cost per unit of a candidate's energy ([`crate::follow`]).
     energy_weight: f32,
@@ -174,6 +183,7 @@ impl Penalties {
         segment: [0; HISTORY],
         cost: [0.0; HISTORY],
         usage: [0.0; HISTORY],
+        line: f32::INFINITY,
         len: 0,
         energy_weight: 0.0,
         rest: [0; REST_EXTRAS],
@@ -241,6 +251,10 @@ impl Penalties {
             return p;
         }
         let window_start = now.saturating_sub(usage_ticks);
+        if usage_ticks > 0 {
+            let span = now.clamp(usage_ticks / 2, usage_ticks);
+            p.line = v.usage_cost * HOLD_SHARE * span as f32 / usage_ticks as f32;
+        }
         // Newest first: the first visit of a segment met is its latest entry.
         let mut end = now;
         let (older, newer) = history.as_slices();
@@ -297,9 +311,15 @@ impl Penalties {
     }
 
     /// What continuing (or holding) segment `c` is charged: [`CONTINUE_USAGE_SHARE`] of its
-    /// usage (see the module docs).
+    /// usage, or all of it once `c` has filled more than [`HOLD_SHARE`] of what the run has
+    /// played (see the module docs).
     pub fn continuing(&self, c: usize) -> f32 {
-        CONTINUE_USAGE_SHARE * self.usage_of(c)
+        let u = self.usage_of(c);
+        if u > self.line {
+            u
+        } else {
+            CONTINUE_USAGE_SHARE * u
+        }
     }
 }
 
@@ -596,15 +616,41 @@ mod tests {
         let d = select(&Playing, 0, &[1.0], &p);
         assert_eq!(d.choice, Choice::Continue);
         assert!((d.cost - 1.05).abs() < 1e-6, "{}", d.cost);
-        // Playing for the whole 100-tick window at a usage cost of 4: continuing costs
-        // 1 + 4 / 4 = 2 > 1.5.
-        let p = Penalties::new(&v(4.0), &history(&[(0, 0)]), 100, 100, 100);
-        assert_eq!(select(&Playing, 0, &[1.0], &p).choice, Choice::Enter(1));
-        // At 1.6 it costs 1 + 0.4 = 1.4 < 1.5 and plays on (charged the whole usage, 2.6, it
-        // would have left).
-        let p = Penalties::new(&v(1.6), &history(&[(0, 0)]), 100, 100, 100);
+        // Played 12 of the 100-tick window (under the line, 14) at a usage cost of 10:
+        // continuing costs 1 + 1.2 / 4 = 1.3 < 1.5 and plays on.
+        let p = Penalties::new(&v(10.0), &history(&[(0, 88)]), 100, 100, 100);
         let d = select(&Playing, 0, &[1.0], &p);
         assert_eq!(d.choice, Choice::Continue);
-        assert!((d.cost - 1.4).abs() < 1e-6, "{}", d.cost);
+        assert!((d.cost - 1.3).abs() < 1e-6, "{}", d.cost);
+    }
+
+    /// A segment that has filled more than [`HOLD_SHARE`] of what the run has played pays its
+    /// whole usage for continuing: it gives way before it breaks the variety line. A young run
+    /// counts as half the usage window, so one gesture of ordinary length is never over it.
+    #[test]
+    fn continuing_over_the_variety_line_pays_the_whole_usage() {
+        let v = Variety {
+            recency_cost: 0.0,
+            recency_ms: 0,
+            usage_cost: 10.0,
+            usage_ms: 0,
+        };
+        // 16 of 100 ticks (over 14): continuing pays all of 1.6, 1 + 1.6 > 1.5, and it leaves
+        // (a quarter, 1.4, would have played on).
+        let p = Penalties::new(&v, &history(&[(0, 84)]), 100, 100, 100);
+        assert!((p.continuing(0) - 1.6).abs() < 1e-6, "{}", p.continuing(0));
+        assert_eq!(select(&Playing, 0, &[1.0], &p).choice, Choice::Enter(1));
+        // Two plays of 8 ticks add up the same way.
+        let p = Penalties::new(&v, &history(&[(0, 60), (1, 68), (0, 92)]), 100, 100, 100);
+        assert!((p.continuing(0) - 1.6).abs() < 1e-6, "{}", p.continuing(0));
+        // A run 30 ticks old is measured as 50 (half the window): the line is 7 ticks. Six
+        // ticks (a fifth of the run) pay a quarter, eight the whole.
+        let p = Penalties::new(&v, &history(&[(0, 24)]), 30, 100, 100);
+        assert!((p.continuing(0) - 0.15).abs() < 1e-6, "{}", p.continuing(0));
+        let p = Penalties::new(&v, &history(&[(0, 22)]), 30, 100, 100);
+        assert!((p.continuing(0) - 0.8).abs() < 1e-6, "{}", p.continuing(0));
+        // The whole window played, as the usage cost is set: all of it.
+        let p = Penalties::new(&v, &history(&[(0, 0)]), 100, 100, 100);
+        assert!((p.continuing(0) - 10.0).abs() < 1e-6, "{}", p.continuing(0));
     }
 }
