@@ -7,13 +7,6 @@ use crate::policy::{PolicyTables, REST_EXTRAS};
 /// The calmest segments, candidates at every exit point while resting.
 pub const REST_SET: usize = 6;
 
-/// The most of the variety costs' usage window (`usage_ms`) one rest may fill while it holds
-/// a pause before it hands over to another ([`RestSet::hand_over`]): the variety line (no
-/// segment over 15 % of a run) less a margin for the blend; 6.3 s of the default 45 s. Past
-/// the same share of what a run has played, continuing any segment pays its whole usage
-/// ([`crate::policy::Penalties::continuing`]).
-pub const HOLD_SHARE: f32 = 0.14;
-
 /// The calmest segments of `t` (lowest energy, ties to the lower index), in order of energy:
 /// [`REST_SET`], or the calmer half of a smaller library (at least one), so a rest is never
 /// any segment at all.

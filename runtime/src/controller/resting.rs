@@ -5,9 +5,9 @@
 use super::rest_entry::{rest_entry, span_ends};
 use super::{Controller, ControllerEvent};
 use crate::player::{LibraryFrames, PlayerCommand};
+use crate::policy::HOLD_SHARE;
 use crate::policy::{Penalties, PolicyTables};
 use crate::prosody::arith::Arith;
-use crate::rest::HOLD_SHARE;
 
 impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'_, T, L, A> {
     /// After the pose of `tick`, with rest segment `segment` playing while resting: turns at

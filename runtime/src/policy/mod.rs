@@ -60,13 +60,19 @@ pub use style::{Style, StyleError, MAX_TONES};
 pub use tables::{PolicyTables, MAX_LABELLED, MAX_LABELS};
 pub use timing::DecisionTiming;
 
-use crate::rest::HOLD_SHARE;
 use heapless::HistoryBuffer;
 
 /// Most rest segments ([`crate::follow::RestSet`]) a decision adds as candidates while
 /// resting (each candidate costs a dot product per value table mixed: six under a three-tone
 /// style took the worst decision past 50 k instructions on a Cortex-M4F).
 pub const REST_EXTRAS: usize = 3;
+
+/// The most of the variety costs' usage window (`usage_ms`) one segment may fill: the variety
+/// line (no segment over 15 % of a run) less a margin for the blend; 6.3 s of the default
+/// 45 s. A rest that holds a pause this long hands over to another
+/// (`crate::rest::RestSet::hand_over`), and past this share of what a run has played,
+/// continuing any segment pays its whole usage ([`Penalties::continuing`]).
+pub const HOLD_SHARE: f32 = 0.14;
 
 /// What to do at an exit point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
