@@ -5,8 +5,7 @@
 use super::rest_entry::{rest_entry, span_ends};
 use super::{Controller, ControllerEvent};
 use crate::player::{LibraryFrames, PlayerCommand};
-use crate::policy::HOLD_SHARE;
-use crate::policy::{Penalties, PolicyTables};
+use crate::policy::{Penalties, PolicyTables, HOLD_SHARE};
 use crate::prosody::arith::Arith;
 
 impl<T: PolicyTables + ?Sized, L: LibraryFrames + ?Sized, A: Arith> Controller<'_, T, L, A> {

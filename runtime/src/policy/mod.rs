@@ -329,8 +329,9 @@ impl Penalties {
     }
 }
 
-/// The share of a segment's usage cost that continuing it pays (see the module docs): with
-/// the default usage cost of 24 it pays 6 (12 when it paid the whole of a usage cost of 12).
+/// The share of a segment's usage cost that continuing it pays while it is under the variety
+/// line ([`HOLD_SHARE`]; see the module docs): with the default usage cost of 24 it pays at
+/// most 6 of a whole window (12 when it paid the whole of a usage cost of 12).
 pub const CONTINUE_USAGE_SHARE: f32 = 0.25;
 
 /// The cheapest action at exit `e` under belief `b` (which has `t.states()` entries), each
@@ -655,7 +656,7 @@ mod tests {
         assert!((p.continuing(0) - 0.15).abs() < 1e-6, "{}", p.continuing(0));
         let p = Penalties::new(&v, &history(&[(0, 22)]), 30, 100, 100);
         assert!((p.continuing(0) - 0.8).abs() < 1e-6, "{}", p.continuing(0));
-        // The whole window played, as the usage cost is set: all of it.
+        // The whole window played: the whole usage cost.
         let p = Penalties::new(&v, &history(&[(0, 0)]), 100, 100, 100);
         assert!((p.continuing(0) - 10.0).abs() < 1e-6, "{}", p.continuing(0));
     }
